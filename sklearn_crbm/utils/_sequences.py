@@ -1,0 +1,254 @@
+"""Sequence bookkeeping: ``sequence_ids`` checks, history indexing, minibatch plans.
+
+Data is in long format: ``X`` has shape ``(n_frames, n_features)`` with all
+sequences stacked, each one contiguous and in time order.  ``sequence_ids``
+holds one integer per frame; equal ids mark one sequence.  Everything that
+needs the past of a frame gets it from here by index arithmetic, so no
+estimator ever materialises the history of the whole data set.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "Sequences",
+    "balanced_batches",
+    "check_sequence_ids",
+    "frame_history",
+    "history_indices",
+    "shuffled_batches",
+]
+
+
+@dataclass(frozen=True)
+class Sequences:
+    """Where each sequence of a long-format array starts and how long it is.
+
+    Attributes
+    ----------
+    starts : ndarray of shape (n_sequences,)
+        Index of the first frame of each sequence, in order of appearance.
+    lengths : ndarray of shape (n_sequences,)
+        Number of frames of each sequence.
+    ids : ndarray of shape (n_sequences,)
+        The id of each sequence as given by the user (``arange`` when the
+        user gave ``None``).
+    """
+
+    starts: np.ndarray
+    lengths: np.ndarray
+    ids: np.ndarray
+
+    @property
+    def n_frames(self):
+        return int(self.lengths.sum())
+
+    @property
+    def n_sequences(self):
+        return len(self.starts)
+
+    @property
+    def stops(self):
+        return self.starts + self.lengths
+
+    def frame_starts(self):
+        """Index of the first frame of its sequence, for every frame."""
+        return np.repeat(self.starts, self.lengths)
+
+    def valid_frames(self, order):
+        """Indices of the frames that have ``order`` past frames in their sequence."""
+        first = self.starts + order
+        counts = np.maximum(self.stops - first, 0)
+        return _ranges(first, counts)
+
+    def per_frame_ids(self):
+        """Sequence id of every frame."""
+        return np.repeat(self.ids, self.lengths)
+
+
+def _ranges(starts, counts):
+    """Concatenate ``arange(s, s + c)`` for every pair, without a Python loop."""
+    counts = np.asarray(counts, dtype=np.intp)
+    total = int(counts.sum())
+    if total == 0:
+        return np.empty(0, dtype=np.intp)
+    offsets = np.repeat(np.asarray(starts, dtype=np.intp) - np.cumsum(counts) + counts, counts)
+    return offsets + np.arange(total, dtype=np.intp)
+
+
+def check_sequence_ids(sequence_ids, n_frames):
+    """Validate ``sequence_ids`` and describe the sequences it marks.
+
+    Parameters
+    ----------
+    sequence_ids : array-like of shape (n_frames,) or None
+        One integer id per frame.  Each id must form exactly one contiguous
+        run.  ``None`` means that all frames form one sequence.
+    n_frames : int
+        Number of rows of the ``X`` the ids belong to.
+
+    Returns
+    -------
+    sequences : Sequences
+        Start and length of every sequence.
+
+    Raises
+    ------
+    ValueError
+        If the ids have the wrong shape or length, contain NaN, or an id
+        occurs in more than one run.
+    TypeError
+        If the ids are not integers.
+    """
+    if sequence_ids is None:
+        return Sequences(
+            starts=np.zeros(1 if n_frames else 0, dtype=np.intp),
+            lengths=np.full(1 if n_frames else 0, n_frames, dtype=np.intp),
+            ids=np.zeros(1 if n_frames else 0, dtype=np.intp),
+        )
+    if hasattr(sequence_ids, "toarray") or hasattr(sequence_ids, "tocsr"):
+        raise TypeError(
+            "sequence_ids must be a dense 1-D array of integers, got a sparse matrix."
+        )
+    ids = np.asarray(sequence_ids)
+    if ids.ndim != 1:
+        raise ValueError(
+            f"sequence_ids must be 1-D with one id per frame, got an array of "
+            f"shape {ids.shape}."
+        )
+    if ids.shape[0] != n_frames:
+        raise ValueError(
+            f"sequence_ids has {ids.shape[0]} entries but X has {n_frames} frames; "
+            "pass one sequence id per row of X."
+        )
+    ids = _as_integer_ids(ids)
+    if n_frames == 0:
+        empty = np.empty(0, dtype=np.intp)
+        return Sequences(starts=empty, lengths=empty.copy(), ids=ids[:0])
+    change = np.flatnonzero(ids[1:] != ids[:-1]) + 1
+    starts = np.concatenate(([0], change)).astype(np.intp)
+    run_ids = ids[starts]
+    unique, counts = np.unique(run_ids, return_counts=True)
+    if np.any(counts > 1):
+        offending = unique[counts > 1][0].item()
+        raise ValueError(
+            f"sequence id {offending!r} occurs in more than one contiguous run of "
+            "frames; each sequence must be stored as one contiguous block in time "
+            "order. Sort X and sequence_ids by (sequence, time) or give the runs "
+            "distinct ids."
+        )
+    lengths = np.diff(np.concatenate((starts, [n_frames]))).astype(np.intp)
+    return Sequences(starts=starts, lengths=lengths, ids=run_ids)
+
+
+def _as_integer_ids(ids):
+    kind = ids.dtype.kind
+    if kind in "iu":
+        return ids
+    if kind == "b":
+        raise TypeError("sequence_ids must be integers, got booleans.")
+    if kind == "f":
+        if not np.all(np.isfinite(ids)):
+            raise ValueError(
+                "sequence_ids contains NaN or infinity; give every frame an "
+                "integer sequence id."
+            )
+        if np.any(ids != np.round(ids)):
+            raise TypeError(
+                "sequence_ids must be integers, got non-integral floats; give "
+                "every frame an integer sequence id."
+            )
+        return ids.astype(np.int64)
+    if kind == "O":
+        try:
+            as_int = ids.astype(np.int64)
+        except (TypeError, ValueError) as exc:
+            raise TypeError(
+                "sequence_ids must be integers; got objects that are not. Map "
+                "sequence names to integers, e.g. with np.unique(names, "
+                "return_inverse=True)."
+            ) from exc
+        if not np.array_equal(as_int, ids):
+            raise TypeError("sequence_ids must be integers.")
+        return as_int
+    raise TypeError(
+        f"sequence_ids must be integers, got dtype {ids.dtype}. Map sequence "
+        "names to integers, e.g. with np.unique(names, return_inverse=True)."
+    )
+
+
+def history_indices(frames, n_lags, frame_starts=None):
+    """Row indices of the ``n_lags`` past frames of each frame, most recent first.
+
+    Parameters
+    ----------
+    frames : ndarray of shape (n,)
+        Indices of the frames whose history is wanted.
+    n_lags : int
+        How many past frames.
+    frame_starts : ndarray of shape (n,), default=None
+        First frame of the sequence of each frame.  When given, a lag that
+        would reach before the start of the sequence is clipped to that start
+        (the first frame is repeated); when None the caller guarantees that
+        every frame has a full history.
+
+    Returns
+    -------
+    indices : ndarray of shape (n, n_lags)
+        ``indices[i, q - 1]`` is the row of frame ``frames[i] - q``.
+    """
+    lags = np.arange(1, n_lags + 1, dtype=np.intp)
+    indices = np.asarray(frames, dtype=np.intp)[:, None] - lags
+    if frame_starts is not None:
+        np.maximum(indices, np.asarray(frame_starts, dtype=np.intp)[:, None], out=indices)
+    return indices
+
+
+def frame_history(X, frames, n_lags, frame_starts=None, out=None):
+    """Gather the flattened history ``[x[t-1], ..., x[t-n_lags]]`` of each frame.
+
+    Returns an array of shape ``(len(frames), n_lags * n_features)`` whose
+    block ``q - 1`` holds frame ``t - q``.
+    """
+    indices = history_indices(frames, n_lags, frame_starts)
+    n_features = X.shape[1]
+    if out is None:
+        return X[indices.ravel()].reshape(len(indices), n_lags * n_features)
+    np.take(X, indices.ravel(), axis=0, out=out.reshape(-1, n_features))
+    return out
+
+
+def shuffled_batches(frames, batch_size, rng):
+    """The original code's plan: all valid frames shuffled, cut into batches.
+
+    Returns a list of index arrays; only the last batch may be smaller.
+    """
+    order = rng.permutation(frames)
+    return [order[i : i + batch_size] for i in range(0, len(order), batch_size)]
+
+
+def balanced_batches(frames, batch_size, rng):
+    """The paper's plan: every batch holds one frame from each chunk.
+
+    The valid frames, in time order, are cut into consecutive chunks of
+    ``n_batches`` frames; the frames of each chunk are dealt at random to the
+    batches, one each.  Every batch thus draws about evenly from the whole
+    data set (every sequence, every style) and holds no two neighbouring
+    frames, which keeps the frames of a batch as uncorrelated as possible.
+    """
+    n_frames = len(frames)
+    if n_frames == 0:
+        return []
+    n_batches = -(-n_frames // batch_size)
+    n_chunks = -(-n_frames // n_batches)
+    padded = np.full(n_chunks * n_batches, -1, dtype=np.intp)
+    padded[:n_frames] = frames
+    chunks = padded.reshape(n_chunks, n_batches)
+    chunks = rng.permuted(chunks, axis=1)
+    batches = []
+    for column in chunks.T[rng.permutation(n_batches)]:
+        batch = column[column >= 0]
+        if len(batch):
+            batches.append(batch)
+    return batches
