@@ -127,8 +127,8 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
     past_to_hidden_ : ndarray of shape (hidden_order, n_components, n_features)
         ``past_to_hidden_[q - 1] @ x[t - q]`` adds to the hidden input of
         frame ``t``.
-    seed_windows_ : ndarray of shape (n_windows, max(order, hidden_order, 1), n_features)
-        Windows of consecutive training frames kept to seed :meth:`sample`.
+    seed_windows_ : ndarray of shape (n_windows, width, n_features)
+        ``width = max(order, hidden_order, 1)``. Windows of consecutive training frames kept to seed :meth:`sample`.
     reconstruction_error_ : float
         Mean squared reconstruction error per trainable frame (summed over
         features) in the last epoch.
@@ -329,7 +329,7 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
         return self.order if self.hidden_order is None else self.hidden_order
 
     def _check_sequences(self, X, sequence_ids):
-        """Validate ids and the visible type; return the sequences and trainable frames."""
+        """Validate ids and visible type; return the sequences and trainable frames."""
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
         if self.visible_type == BINARY and (X.min() < 0 or X.max() > 1):
             raise ValueError(
@@ -386,7 +386,9 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
         params = self._params()
         velocities = self._velocities
         decays = (self.weight_decay, 0.0, 0.0, self.weight_decay)
-        plan_batches = balanced_batches if self.batching == "balanced" else shuffled_batches
+        plan_batches = (
+            balanced_batches if self.batching == "balanced" else shuffled_batches
+        )
         n_lags = params.n_lags
         history = np.empty((self.batch_size, n_lags * X.shape[1]), dtype=X.dtype)
         start = time.perf_counter()
@@ -395,14 +397,16 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
             momentum = self.momentum if self.n_iter_ >= self.momentum_delay else 0.0
             squared_error = 0.0
             for batch in plan_batches(frames, self.batch_size, rng):
-                batch_history = frame_history(X, batch, n_lags, out=history[: len(batch)])
+                batch_history = frame_history(
+                    X, batch, n_lags, out=history[: len(batch)]
+                )
                 gradients, error = cd_gradients(
                     params, X[batch], batch_history, self.cd_steps, rng
                 )
                 squared_error += error
                 step = self.learning_rate / len(batch)
                 for array, gradient, velocity, decay in zip(
-                    params.arrays(), gradients, velocities, decays
+                    params.arrays(), gradients, velocities, decays, strict=True
                 ):
                     velocity *= momentum
                     velocity += step * gradient
@@ -721,7 +725,9 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
     ):
         n_sequences, width, n_features = seed.shape
         n_lags = params.n_lags
-        frames = np.empty((n_sequences, width + n_samples, n_features), dtype=seed.dtype)
+        frames = np.empty(
+            (n_sequences, width + n_samples, n_features), dtype=seed.dtype
+        )
         frames[:, :width] = seed
         for t in range(width, width + n_samples):
             history = frames[:, t - n_lags : t][:, ::-1].reshape(

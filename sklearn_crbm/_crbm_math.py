@@ -47,7 +47,14 @@ class CRBMParameters:
     """
 
     def __init__(
-        self, weights, hidden_bias, visible_bias, dynamic, order, hidden_order, visible_type
+        self,
+        weights,
+        hidden_bias,
+        visible_bias,
+        dynamic,
+        order,
+        hidden_order,
+        visible_type,
     ):
         self.weights = weights
         self.hidden_bias = hidden_bias
@@ -116,8 +123,12 @@ class CRBMParameters:
         n_components, n_features = components.shape
         order, hidden_order = len(autoregressive), len(past_to_hidden)
         n_lags = max(order, hidden_order)
-        dynamic = np.zeros((n_features + n_components, n_lags * n_features), dtype=dtype)
-        dynamic[:n_features, : order * n_features] = _lag_blocks_to_matrix(autoregressive)
+        dynamic = np.zeros(
+            (n_features + n_components, n_lags * n_features), dtype=dtype
+        )
+        dynamic[:n_features, : order * n_features] = _lag_blocks_to_matrix(
+            autoregressive
+        )
         dynamic[n_features:, : hidden_order * n_features] = _lag_blocks_to_matrix(
             past_to_hidden
         )
@@ -132,7 +143,7 @@ class CRBMParameters:
         )
 
     def autoregressive(self):
-        """``A`` as ``(order, n_features, n_features)``; block ``q-1`` acts on ``x[t-q]``."""
+        """A as ``(order, n_features, n_features)``; block ``q-1`` acts on ``x[t-q]``."""
         n = self.n_features
         return _matrix_to_lag_blocks(self.dynamic[:n, : self.order * n], self.order, n)
 
@@ -187,7 +198,9 @@ def dynamic_biases(params, history):
         shape = (history.shape[0], 1)
         return (
             np.broadcast_to(params.visible_bias, shape[:1] + (n,)).copy(),
-            np.broadcast_to(params.hidden_bias, shape[:1] + (params.n_components,)).copy(),
+            np.broadcast_to(
+                params.hidden_bias, shape[:1] + (params.n_components,)
+            ).copy(),
         )
     both = history @ params.dynamic.T
     both[:, :n] += params.visible_bias
@@ -266,13 +279,17 @@ def cd_gradients(params, visible, history, cd_steps, rng):
     hidden = positive_states
     for step in range(cd_steps):
         reconstruction = visible_means(params, hidden, visible_bias)
-        negative_probabilities = hidden_probabilities(params, reconstruction, hidden_bias)
+        negative_probabilities = hidden_probabilities(
+            params, reconstruction, hidden_bias
+        )
         if step + 1 < cd_steps:
             hidden = sample_bernoulli(negative_probabilities, rng)
 
     visible_delta = visible - reconstruction
     hidden_delta = positive_states - negative_probabilities
-    grad_weights = positive_states.T @ visible - negative_probabilities.T @ reconstruction
+    grad_weights = (
+        positive_states.T @ visible - negative_probabilities.T @ reconstruction
+    )
     grad_hidden_bias = hidden_delta.sum(axis=0)
     grad_visible_bias = visible_delta.sum(axis=0)
     if params.n_lags:
@@ -282,7 +299,12 @@ def cd_gradients(params, visible, history, cd_steps, rng):
     else:
         grad_dynamic = np.zeros_like(params.dynamic)
     squared_error = float(np.einsum("ij,ij->", visible_delta, visible_delta))
-    return (grad_weights, grad_hidden_bias, grad_visible_bias, grad_dynamic), squared_error
+    return (
+        grad_weights,
+        grad_hidden_bias,
+        grad_visible_bias,
+        grad_dynamic,
+    ), squared_error
 
 
 def gibbs_frames(

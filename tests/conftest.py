@@ -14,7 +14,10 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 
 
 def _find_data_home():
-    candidates = [os.environ.get("SKLEARN_CRBM_DATA"), REPO_ROOT.parent / "shared" / "data"]
+    candidates = [
+        os.environ.get("SKLEARN_CRBM_DATA"),
+        REPO_ROOT.parent / "shared" / "data",
+    ]
     for candidate in candidates:
         if candidate and (Path(candidate) / "cmu_subject35").is_dir():
             return Path(candidate)

@@ -35,23 +35,32 @@ def oscillations(n_sequences=4, n_frames=40, n_features=5, seed=0):
     for _ in range(n_sequences):
         t = np.arange(n_frames) * 0.3 + rng.uniform(0, 2 * np.pi)
         phases = np.arange(n_features) * 0.7
-        blocks.append(np.sin(t[:, None] + phases) + 0.05 * rng.standard_normal((n_frames, n_features)))
+        blocks.append(
+            np.sin(t[:, None] + phases)
+            + 0.05 * rng.standard_normal((n_frames, n_features))
+        )
     X = np.concatenate(blocks)
     return X, np.repeat(np.arange(n_sequences), n_frames)
 
 
-def random_model(n_features=3, n_components=4, order=2, hidden_order=None, seed=0, scale=0.5):
+def random_model(
+    n_features=3, n_components=4, order=2, hidden_order=None, seed=0, scale=0.5
+):
     """A ConditionalRBM with random parameters set by hand (no training)."""
     hidden_order = order if hidden_order is None else hidden_order
     rng = np.random.default_rng(seed)
-    model = ConditionalRBM(n_components, order=order, hidden_order=hidden_order, n_iter=1, random_state=0)
+    model = ConditionalRBM(
+        n_components, order=order, hidden_order=hidden_order, n_iter=1, random_state=0
+    )
     X = rng.standard_normal((max(order, hidden_order) + 5, n_features))
     model.fit(X)
     model.components_ = scale * rng.standard_normal((n_components, n_features))
     model.intercept_hidden_ = scale * rng.standard_normal(n_components)
     model.intercept_visible_ = scale * rng.standard_normal(n_features)
     model.autoregressive_ = 0.3 * rng.standard_normal((order, n_features, n_features))
-    model.past_to_hidden_ = scale * rng.standard_normal((hidden_order, n_components, n_features))
+    model.past_to_hidden_ = scale * rng.standard_normal(
+        (hidden_order, n_components, n_features)
+    )
     return model
 
 
@@ -90,7 +99,9 @@ def exact_log_likelihood(model, X, sequence_ids):
             c_hat, b_hat = exact_dynamic_biases(model, past)
             H, p_h = exact_hidden_posterior_given_history(model, c_hat, b_hat)
             means = c_hat + H @ model.components_
-            log_normal = -0.5 * np.sum((seq[t] - means) ** 2, axis=1) - 0.5 * d * np.log(2 * np.pi)
+            log_normal = -0.5 * np.sum(
+                (seq[t] - means) ** 2, axis=1
+            ) - 0.5 * d * np.log(2 * np.pi)
             total += logsumexp(log_normal + np.log(p_h))
             count += 1
     return total / count
@@ -121,7 +132,9 @@ def sample_from_model(model, n_sequences, n_frames, seed):
 )
 def test_fitted_attribute_shapes(order, hidden_order, expected_lags):
     X, ids = oscillations()
-    model = ConditionalRBM(7, order=order, hidden_order=hidden_order, n_iter=2, random_state=0)
+    model = ConditionalRBM(
+        7, order=order, hidden_order=hidden_order, n_iter=2, random_state=0
+    )
     model.fit(X, sequence_ids=ids)
     hidden_order = order if hidden_order is None else hidden_order
     assert model.components_.shape == (7, 5)
@@ -132,7 +145,9 @@ def test_fitted_attribute_shapes(order, hidden_order, expected_lags):
     assert model.seed_windows_.shape[1:] == (max(expected_lags, 1), 5)
     assert model.n_iter_ == 2
     assert model.n_features_in_ == 5
-    assert_array_equal(model.get_feature_names_out(), [f"conditionalrbm{i}" for i in range(7)])
+    assert_array_equal(
+        model.get_feature_names_out(), [f"conditionalrbm{i}" for i in range(7)]
+    )
 
 
 def test_initialisation_follows_original_code():
@@ -179,9 +194,13 @@ def test_visible_mean_and_free_energy_match_exact_density():
         c_hat, b_hat = exact_dynamic_biases(model, X[t - 2 : t][::-1])
         H, p_h = exact_hidden_posterior_given_history(model, c_hat, b_hat)
         means = c_hat + H @ model.components_
-        log_p = logsumexp(-0.5 * np.sum((X[t] - means) ** 2, axis=1) + np.log(p_h)) - 1.5 * np.log(2 * np.pi)
+        log_p = logsumexp(
+            -0.5 * np.sum((X[t] - means) ** 2, axis=1) + np.log(p_h)
+        ) - 1.5 * np.log(2 * np.pi)
         top_down = H @ model.components_
-        log_z = logsumexp(H @ b_hat + top_down @ c_hat + 0.5 * np.sum(top_down**2, axis=1)) + 1.5 * np.log(2 * np.pi)
+        log_z = logsumexp(
+            H @ b_hat + top_down @ c_hat + 0.5 * np.sum(top_down**2, axis=1)
+        ) + 1.5 * np.log(2 * np.pi)
         assert neg_free_energy[t] - log_z == pytest.approx(log_p, rel=1e-10)
 
 
@@ -197,7 +216,12 @@ def test_long_gibbs_chains_match_exact_conditional_moments():
 
     n_chains = 20000
     samples = model.sample(
-        1, history=past[::-1], n_sequences=n_chains, n_gibbs=60, sample_visibles=True, random_state=0
+        1,
+        history=past[::-1],
+        n_sequences=n_chains,
+        n_gibbs=60,
+        sample_visibles=True,
+        random_state=0,
     )
     standard_error = np.sqrt(np.diag(exact_cov) / n_chains)
     assert np.all(np.abs(samples.mean(axis=0) - exact_mean) < 4 * standard_error)
@@ -208,7 +232,9 @@ def test_training_on_crbm_data_raises_exact_likelihood():
     truth = random_model(n_features=3, n_components=3, order=1, seed=7, scale=1.0)
     X, ids = sample_from_model(truth, n_sequences=6, n_frames=80, seed=1)
     X_test, ids_test = sample_from_model(truth, n_sequences=3, n_frames=60, seed=2)
-    model = ConditionalRBM(3, order=1, learning_rate=0.01, batch_size=20, n_iter=1, random_state=0)
+    model = ConditionalRBM(
+        3, order=1, learning_rate=0.01, batch_size=20, n_iter=1, random_state=0
+    )
     model.fit(X, sequence_ids=ids)
     before = exact_log_likelihood(model, X_test, ids_test)
     for _ in range(150):
@@ -239,21 +265,37 @@ def test_one_cd1_update_equals_paper_equations():
         v, past = X[t], X[[t - 1, t - 2]]
         c_hat = c + A[0] @ past[0] + A[1] @ past[1]
         b_hat = b + B[0] @ past[0] + B[1] @ past[1]
-        h_data = (uniform[row] < expit(b_hat + W @ v)).astype(float)  # binary states (§2.2)
+        h_data = (uniform[row] < expit(b_hat + W @ v)).astype(
+            float
+        )  # binary states (§2.2)
         v_recon = c_hat + W.T @ h_data  # visible mean from binary states
         h_recon = expit(b_hat + W @ v_recon)  # probabilities under the reconstruction
-        grad["W"] = grad["W"] + np.outer(h_data, v) - np.outer(h_recon, v_recon)  # Eq. 4
+        grad["W"] = (
+            grad["W"] + np.outer(h_data, v) - np.outer(h_recon, v_recon)
+        )  # Eq. 4
         grad["b"] = grad["b"] + h_data - h_recon  # Eq. 5
         grad["c"] = grad["c"] + (v - c_hat) - (v_recon - c_hat)
-        grad["B"] = grad["B"] + np.stack([np.outer(h_data - h_recon, p) for p in past])  # Eq. 6
-        grad["A"] = grad["A"] + np.stack([np.outer(v - v_recon, p) for p in past])  # Eq. 7
-    n, lr, wd = len(batch), model.learning_rate, model.weight_decay  # momentum is 0 in epoch 2
+        grad["B"] = grad["B"] + np.stack(
+            [np.outer(h_data - h_recon, p) for p in past]
+        )  # Eq. 6
+        grad["A"] = grad["A"] + np.stack(
+            [np.outer(v - v_recon, p) for p in past]
+        )  # Eq. 7
+    n, lr, wd = (
+        len(batch),
+        model.learning_rate,
+        model.weight_decay,
+    )  # momentum is 0 in epoch 2
     model.partial_fit(X, sequence_ids=ids)
     assert_allclose(model.components_, W + lr * (grad["W"] / n - wd * W), rtol=1e-10)
     assert_allclose(model.intercept_hidden_, b + lr * grad["b"] / n, rtol=1e-10)
     assert_allclose(model.intercept_visible_, c + lr * grad["c"] / n, rtol=1e-10)
-    assert_allclose(model.autoregressive_, A + lr * (grad["A"] / n - wd * A), rtol=1e-10)
-    assert_allclose(model.past_to_hidden_, B + lr * (grad["B"] / n - wd * B), rtol=1e-10)
+    assert_allclose(
+        model.autoregressive_, A + lr * (grad["A"] / n - wd * A), rtol=1e-10
+    )
+    assert_allclose(
+        model.past_to_hidden_, B + lr * (grad["B"] / n - wd * B), rtol=1e-10
+    )
 
 
 def test_momentum_starts_after_delay():
@@ -285,16 +327,25 @@ def test_cd_k_runs_k_reconstructions():
 def test_history_never_crosses_sequence_boundary():
     model = random_model(order=2)
     X, ids = oscillations(n_sequences=3, n_frames=10, n_features=3)
-    together = [model.transform(X, sequence_ids=ids), model.score_samples(X, sequence_ids=ids),
-                model.predict_next(X, sequence_ids=ids)]
+    together = [
+        model.transform(X, sequence_ids=ids),
+        model.score_samples(X, sequence_ids=ids),
+        model.predict_next(X, sequence_ids=ids),
+    ]
     for sid in range(3):
         alone = X[ids == sid]
-        for whole, method in zip(together, ("transform", "score_samples", "predict_next")):
-            assert_allclose(whole[ids == sid], getattr(model, method)(alone), rtol=1e-12)
+        for whole, method in zip(
+            together, ("transform", "score_samples", "predict_next"), strict=True
+        ):
+            assert_allclose(
+                whole[ids == sid], getattr(model, method)(alone), rtol=1e-12
+            )
     # changing one sequence changes nothing in the others
     X_changed = X.copy()
     X_changed[ids == 0] += 5.0
-    assert_allclose(model.transform(X_changed, sequence_ids=ids)[ids != 0], together[0][ids != 0])
+    assert_allclose(
+        model.transform(X_changed, sequence_ids=ids)[ids != 0], together[0][ids != 0]
+    )
 
 
 def test_training_skips_frames_without_full_history():
@@ -303,7 +354,9 @@ def test_training_skips_frames_without_full_history():
     short = np.full((3, 3), 1e6)  # would blow training up if used as current frame
     X_all = np.concatenate([X, short])
     ids_all = np.concatenate([ids, [7, 7, 7]])
-    a = ConditionalRBM(4, order=3, n_iter=3, random_state=0).fit(X_all, sequence_ids=ids_all)
+    a = ConditionalRBM(4, order=3, n_iter=3, random_state=0).fit(
+        X_all, sequence_ids=ids_all
+    )
     b = ConditionalRBM(4, order=3, n_iter=3, random_state=0).fit(X, sequence_ids=ids)
     assert_allclose(a.components_, b.components_)
 
@@ -313,14 +366,18 @@ def test_score_is_mean_squared_one_step_error_on_valid_frames():
     X, ids = oscillations(n_sequences=2, n_frames=12, n_features=3)
     predicted = model.predict_next(X, sequence_ids=ids)
     valid = np.concatenate([np.arange(2, 12), np.arange(14, 24)])
-    assert model.score(X, sequence_ids=ids) == pytest.approx(-np.mean((X[valid] - predicted[valid]) ** 2))
+    assert model.score(X, sequence_ids=ids) == pytest.approx(
+        -np.mean((X[valid] - predicted[valid]) ** 2)
+    )
 
 
 def test_score_prefers_history_on_held_out_sequences():
     X, ids = oscillations(n_sequences=6, n_frames=60)
     train, test = ids < 4, ids >= 4
     scores = {
-        order: ConditionalRBM(20, order=order, n_iter=100, learning_rate=0.01, random_state=0)
+        order: ConditionalRBM(
+            20, order=order, n_iter=100, learning_rate=0.01, random_state=0
+        )
         .fit(X[train], sequence_ids=ids[train])
         .score(X[test], sequence_ids=ids[test])
         for order in (0, 2)
@@ -331,7 +388,9 @@ def test_score_prefers_history_on_held_out_sequences():
 # ----------------------------------------------------------- generation
 def test_sample_shapes_and_seeds():
     X, ids = oscillations()
-    model = ConditionalRBM(8, order=2, n_iter=5, random_state=0).fit(X, sequence_ids=ids)
+    model = ConditionalRBM(8, order=2, n_iter=5, random_state=0).fit(
+        X, sequence_ids=ids
+    )
     assert model.sample(7).shape == (7, 5)
     assert model.sample(7, n_sequences=4).shape == (28, 5)
     seeds = np.stack([X[:2], X[40:42], X[80:82]])
@@ -363,7 +422,9 @@ def test_sample_follows_the_seed_dynamics():
 
 def test_hidden_noise_changes_samples():
     X, ids = oscillations()
-    model = ConditionalRBM(8, order=2, n_iter=5, random_state=0).fit(X, sequence_ids=ids)
+    model = ConditionalRBM(8, order=2, n_iter=5, random_state=0).fit(
+        X, sequence_ids=ids
+    )
     quiet = model.sample(10, random_state=0)
     noisy = model.sample(10, hidden_noise=1.0, random_state=0)
     assert not np.allclose(quiet, noisy)
@@ -374,9 +435,17 @@ def test_same_random_state_same_model_transform_and_samples():
     X, ids = oscillations()
     a = ConditionalRBM(8, order=2, n_iter=5, random_state=42).fit(X, sequence_ids=ids)
     b = ConditionalRBM(8, order=2, n_iter=5, random_state=42).fit(X, sequence_ids=ids)
-    for name in ("components_", "intercept_hidden_", "intercept_visible_", "autoregressive_", "past_to_hidden_"):
+    for name in (
+        "components_",
+        "intercept_hidden_",
+        "intercept_visible_",
+        "autoregressive_",
+        "past_to_hidden_",
+    ):
         assert_array_equal(getattr(a, name), getattr(b, name))
-    assert_array_equal(a.transform(X, sequence_ids=ids), b.transform(X, sequence_ids=ids))
+    assert_array_equal(
+        a.transform(X, sequence_ids=ids), b.transform(X, sequence_ids=ids)
+    )
     assert_array_equal(a.sample(10, n_sequences=3), b.sample(10, n_sequences=3))
     assert_array_equal(a.sample(10, random_state=5), b.sample(10, random_state=5))
     c = ConditionalRBM(8, order=2, n_iter=5, random_state=43).fit(X, sequence_ids=ids)
@@ -385,7 +454,9 @@ def test_same_random_state_same_model_transform_and_samples():
 
 def test_partial_fit_epochs_equal_fit():
     X, ids = oscillations()
-    fitted = ConditionalRBM(6, order=2, n_iter=3, random_state=0).fit(X, sequence_ids=ids)
+    fitted = ConditionalRBM(6, order=2, n_iter=3, random_state=0).fit(
+        X, sequence_ids=ids
+    )
     stepped = ConditionalRBM(6, order=2, random_state=0)
     for _ in range(3):
         assert stepped.partial_fit(X, sequence_ids=ids) is stepped
@@ -397,8 +468,17 @@ def test_partial_fit_epochs_equal_fit():
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
 def test_dtype_is_preserved_end_to_end(dtype):
     X, ids = oscillations()
-    model = ConditionalRBM(6, order=2, n_iter=3, random_state=0).fit(X.astype(dtype), sequence_ids=ids)
-    for name in ("components_", "intercept_hidden_", "intercept_visible_", "autoregressive_", "past_to_hidden_", "seed_windows_"):
+    model = ConditionalRBM(6, order=2, n_iter=3, random_state=0).fit(
+        X.astype(dtype), sequence_ids=ids
+    )
+    for name in (
+        "components_",
+        "intercept_hidden_",
+        "intercept_visible_",
+        "autoregressive_",
+        "past_to_hidden_",
+        "seed_windows_",
+    ):
         assert getattr(model, name).dtype == dtype
     assert model.transform(X.astype(dtype)).dtype == dtype
     assert model.score_samples(X.astype(dtype)).dtype == dtype
@@ -408,18 +488,24 @@ def test_dtype_is_preserved_end_to_end(dtype):
 def test_float32_and_float64_learn_alike():
     """The two precisions draw different random bits, so compare what they learn."""
     X, ids = oscillations()
-    a = ConditionalRBM(10, order=2, n_iter=60, learning_rate=0.01, random_state=0).fit(X, sequence_ids=ids)
+    a = ConditionalRBM(10, order=2, n_iter=60, learning_rate=0.01, random_state=0).fit(
+        X, sequence_ids=ids
+    )
     b = ConditionalRBM(10, order=2, n_iter=60, learning_rate=0.01, random_state=0).fit(
         X.astype(np.float32), sequence_ids=ids
     )
     assert b.reconstruction_error_ == pytest.approx(a.reconstruction_error_, rel=0.2)
-    assert b.score(X, sequence_ids=ids) == pytest.approx(a.score(X, sequence_ids=ids), rel=0.2)
+    assert b.score(X, sequence_ids=ids) == pytest.approx(
+        a.score(X, sequence_ids=ids), rel=0.2
+    )
 
 
 # -------------------------------------------------------------- variants
 def test_order_zero_is_a_plain_rbm():
     X, ids = oscillations()
-    model = ConditionalRBM(6, order=0, n_iter=3, random_state=0).fit(X, sequence_ids=ids)
+    model = ConditionalRBM(6, order=0, n_iter=3, random_state=0).fit(
+        X, sequence_ids=ids
+    )
     assert model.autoregressive_.shape == (0, 5, 5)
     expected = expit(X @ model.components_.T + model.intercept_hidden_)
     assert_allclose(model.transform(X), expected, rtol=1e-12)
@@ -431,11 +517,15 @@ def test_order_zero_is_a_plain_rbm():
 def test_binary_visibles():
     rng = np.random.default_rng(0)
     X = (rng.random((120, 6)) < 0.3).astype(float)
-    model = ConditionalRBM(5, order=1, visible_type="binary", n_iter=3, random_state=0).fit(X)
+    model = ConditionalRBM(
+        5, order=1, visible_type="binary", n_iter=3, random_state=0
+    ).fit(X)
     samples = model.sample(5, n_sequences=2)
     assert np.all((samples >= 0) & (samples <= 1))
     params = model._params()
-    H = hidden_probabilities(params, X[1:], params.hidden_bias + X[:-1] @ model.past_to_hidden_[0].T)
+    H = hidden_probabilities(
+        params, X[1:], params.hidden_bias + X[:-1] @ model.past_to_hidden_[0].T
+    )
     assert_allclose(model.transform(X)[1:], H, rtol=1e-12)
     with pytest.raises(ValueError, match=r"binary.*\[0, 1\]"):
         ConditionalRBM(5, visible_type="binary").fit(X * 3)
@@ -452,8 +542,13 @@ def test_verbose_reports_progress(capsys):
 
 def test_divergence_raises_naming_the_learning_rate():
     X, ids = oscillations()
-    model = ConditionalRBM(8, order=2, learning_rate=50.0, momentum_delay=0, n_iter=50, random_state=0)
-    with np.errstate(all="ignore"), pytest.raises(TrainingDivergedError, match="learning_rate=50.0"):
+    model = ConditionalRBM(
+        8, order=2, learning_rate=50.0, momentum_delay=0, n_iter=50, random_state=0
+    )
+    with (
+        np.errstate(all="ignore"),
+        pytest.raises(TrainingDivergedError, match="learning_rate=50.0"),
+    ):
         model.fit(X * 100, sequence_ids=ids)
 
 
@@ -462,17 +557,26 @@ def test_pipeline_routes_sequence_ids():
     direct = ConditionalRBM(6, order=2, n_iter=3, random_state=0)
     direct.fit(StandardScaler().fit_transform(X), sequence_ids=ids)
     with sklearn.config_context(enable_metadata_routing=True):
-        pipe = make_pipeline(StandardScaler(), ConditionalRBM(6, order=2, n_iter=3, random_state=0))
+        pipe = make_pipeline(
+            StandardScaler(), ConditionalRBM(6, order=2, n_iter=3, random_state=0)
+        )
         pipe.fit(X, sequence_ids=ids)
         assert_allclose(pipe[-1].components_, direct.components_)
-        assert_allclose(pipe.transform(X, sequence_ids=ids), direct.transform(StandardScaler().fit_transform(X), sequence_ids=ids))
-        assert pipe.score(X, sequence_ids=ids) == pytest.approx(direct.score(StandardScaler().fit_transform(X), sequence_ids=ids))
+        assert_allclose(
+            pipe.transform(X, sequence_ids=ids),
+            direct.transform(StandardScaler().fit_transform(X), sequence_ids=ids),
+        )
+        assert pipe.score(X, sequence_ids=ids) == pytest.approx(
+            direct.score(StandardScaler().fit_transform(X), sequence_ids=ids)
+        )
 
 
 def test_fit_transform_uses_sequence_ids():
     X, ids = oscillations()
     model = ConditionalRBM(6, order=2, n_iter=3, random_state=0)
-    assert_allclose(model.fit_transform(X, sequence_ids=ids), model.transform(X, sequence_ids=ids))
+    assert_allclose(
+        model.fit_transform(X, sequence_ids=ids), model.transform(X, sequence_ids=ids)
+    )
 
 
 # ------------------------------------------------------------ bad input

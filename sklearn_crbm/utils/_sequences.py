@@ -73,7 +73,9 @@ def _ranges(starts, counts):
     total = int(counts.sum())
     if total == 0:
         return np.empty(0, dtype=np.intp)
-    offsets = np.repeat(np.asarray(starts, dtype=np.intp) - np.cumsum(counts) + counts, counts)
+    offsets = np.repeat(
+        np.asarray(starts, dtype=np.intp) - np.cumsum(counts) + counts, counts
+    )
     return offsets + np.arange(total, dtype=np.intp)
 
 
@@ -201,7 +203,9 @@ def history_indices(frames, n_lags, frame_starts=None):
     lags = np.arange(1, n_lags + 1, dtype=np.intp)
     indices = np.asarray(frames, dtype=np.intp)[:, None] - lags
     if frame_starts is not None:
-        np.maximum(indices, np.asarray(frame_starts, dtype=np.intp)[:, None], out=indices)
+        np.maximum(
+            indices, np.asarray(frame_starts, dtype=np.intp)[:, None], out=indices
+        )
     return indices
 
 

@@ -56,7 +56,9 @@ def test_bad_sequence_ids(ids, error, match):
 def test_history_indices_clip_at_sequence_start():
     frames = np.array([0, 1, 5, 6])
     starts = np.array([0, 0, 5, 5])
-    assert_array_equal(history_indices(frames, 2, starts), [[0, 0], [0, 0], [5, 5], [5, 5]])
+    assert_array_equal(
+        history_indices(frames, 2, starts), [[0, 0], [0, 0], [5, 5], [5, 5]]
+    )
     assert_array_equal(history_indices(np.array([4]), 3), [[3, 2, 1]])
 
 
@@ -70,7 +72,9 @@ def test_frame_history_is_lag_major():
 
 
 @pytest.mark.parametrize("plan", [balanced_batches, shuffled_batches])
-@pytest.mark.parametrize("n_frames, batch_size", [(1000, 100), (1037, 100), (7, 100), (250, 1)])
+@pytest.mark.parametrize(
+    "n_frames, batch_size", [(1000, 100), (1037, 100), (7, 100), (250, 1)]
+)
 def test_batch_plans_cover_every_frame_once(plan, n_frames, batch_size):
     frames = np.arange(10, 10 + n_frames)
     batches = plan(frames, batch_size, np.random.default_rng(0))
