@@ -128,7 +128,8 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
         ``past_to_hidden_[q - 1] @ x[t - q]`` adds to the hidden input of
         frame ``t``.
     seed_windows_ : ndarray of shape (n_windows, width, n_features)
-        ``width = max(order, hidden_order, 1)``. Windows of consecutive training frames kept to seed :meth:`sample`.
+        ``width = max(order, hidden_order, 1)``. Windows of consecutive
+        training frames kept to seed :meth:`sample`.
     reconstruction_error_ : float
         Mean squared reconstruction error per trainable frame (summed over
         features) in the last epoch.

@@ -143,7 +143,7 @@ class CRBMParameters:
         )
 
     def autoregressive(self):
-        """A as ``(order, n_features, n_features)``; block ``q-1`` acts on ``x[t-q]``."""
+        """A as ``(order, n_features, n_features)``; block ``q-1`` acts on x[t-q]."""
         n = self.n_features
         return _matrix_to_lag_blocks(self.dynamic[:n, : self.order * n], self.order, n)
 
