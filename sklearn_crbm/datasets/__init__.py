@@ -1,0 +1,33 @@
+"""Motion-capture data: skeletons, file readers and writers, data sets.
+
+- :class:`Skeleton` and :class:`Bone`: bones, channels, forward kinematics.
+- :func:`read_amc`, :func:`write_amc`, :func:`read_bvh`, :func:`write_bvh`.
+- :func:`load_cmu35` and :func:`load_mit_walk` load the real data from
+  :func:`get_data_home`; :func:`fetch_cmu35` and :func:`fetch_mit_walk`
+  download it.
+- :func:`make_oscillations` and :func:`make_walker` make small synthetic
+  motion for tests and examples.
+"""
+
+from ._acclaim import read_amc, write_amc
+from ._base import get_data_home, load_cmu35, load_mit_walk
+from ._bvh import read_bvh, write_bvh
+from ._fetch import fetch_cmu35, fetch_mit_walk
+from ._generators import make_oscillations, make_walker
+from ._skeleton import Bone, Skeleton
+
+__all__ = [
+    "Bone",
+    "Skeleton",
+    "fetch_cmu35",
+    "fetch_mit_walk",
+    "get_data_home",
+    "load_cmu35",
+    "load_mit_walk",
+    "make_oscillations",
+    "make_walker",
+    "read_amc",
+    "read_bvh",
+    "write_amc",
+    "write_bvh",
+]

@@ -1,0 +1,458 @@
+"""Biovision BVH files: a skeleton header (HIERARCHY) and motion (MOTION)."""
+
+from pathlib import Path
+
+import numpy as np
+
+from ..utils._rotations import matrix_to_euler
+from ._parsing import format_number, parse_error, parse_floats, read_lines
+from ._skeleton import EULER_CHANNELS, TRANSLATION_CHANNELS, Bone, Skeleton
+
+__all__ = ["read_bvh", "read_bvh_skeleton", "write_bvh"]
+
+_BVH_TO_CHANNEL = {
+    f"{axis}{kind}": f"{short}{axis.lower()}"
+    for axis in "XYZ"
+    for kind, short in (("position", "t"), ("rotation", "r"))
+}
+_CHANNEL_TO_BVH = {v: k for k, v in _BVH_TO_CHANNEL.items()}
+END_SITE_SUFFIX = "_end"
+
+
+# ------------------------------------------------------------------ reading
+class _Tokens:
+    """The words of a BVH header with their line numbers, read one at a time."""
+
+    def __init__(self, path, lines):
+        self.path = path
+        self.items = [(n, w) for n, line in lines for w in line.split()]
+        self.pos = 0
+        self.last_line = lines[-1][0] if lines else 1
+
+    def error(self, message, lineno=None):
+        if lineno is None:
+            lineno = (
+                self.items[self.pos][0]
+                if self.pos < len(self.items)
+                else self.last_line
+            )
+        return parse_error(self.path, lineno, message)
+
+    def next(self, what):
+        if self.pos >= len(self.items):
+            raise self.error(f"file ends where {what} was expected")
+        item = self.items[self.pos]
+        self.pos += 1
+        return item
+
+    def expect(self, word):
+        lineno, token = self.next(repr(word))
+        if token.lower() != word.lower():
+            raise self.error(f"expected {word!r}, got {token!r}", lineno)
+        return lineno
+
+    def floats(self, count, what):
+        items = [self.next(what) for _ in range(count)]
+        return parse_floats([t for _, t in items], self.path, items[0][0], what)
+
+
+def _parse_hierarchy(tokens):
+    """Bones of the HIERARCHY, in file order, with end sites as channel-less bones."""
+    lineno, first = tokens.next("'HIERARCHY'")
+    if first.upper() != "HIERARCHY":
+        raise tokens.error(
+            f"expected 'HIERARCHY' at the start of the file, got {first!r}", lineno
+        )
+    tokens.expect("ROOT")
+    bones = []
+    _parse_joint(tokens, None, bones, set())
+    if tokens.pos < len(tokens.items):
+        lineno, token = tokens.items[tokens.pos]
+        raise tokens.error(
+            f"unexpected {token!r} after the ROOT joint (only one ROOT is supported)",
+            lineno,
+        )
+    return bones
+
+
+def _parse_joint(tokens, parent, bones, names):
+    lineno, name = tokens.next("a joint name")
+    if name in names or name + END_SITE_SUFFIX in names:
+        raise tokens.error(f"joint name {name!r} is used twice", lineno)
+    names.add(name)
+    tokens.expect("{")
+    offset, channels, index = None, (), len(bones)
+    bones.append(None)  # placeholder: children come after their parent
+    while True:
+        lineno, word = tokens.next("'}'")
+        key = word.upper()
+        if key == "OFFSET":
+            offset = np.array(tokens.floats(3, "OFFSET value"))
+        elif key == "CHANNELS":
+            channels = _parse_channels(tokens)
+        elif key == "JOINT":
+            _parse_joint(tokens, name, bones, names)
+        elif key == "END":
+            tokens.expect("Site")
+            tokens.expect("{")
+            tokens.expect("OFFSET")
+            end = np.array(tokens.floats(3, "OFFSET value"))
+            tokens.expect("}")
+            names.add(name + END_SITE_SUFFIX)
+            bones.append(_bvh_bone(name + END_SITE_SUFFIX, name, end, ()))
+        elif key == "}":
+            break
+        else:
+            raise tokens.error(f"unexpected {word!r} in joint {name!r}", lineno)
+    if offset is None:
+        raise tokens.error(f"joint {name!r} has no OFFSET", lineno)
+    bones[index] = _bvh_bone(name, parent, offset, channels)
+
+
+def _parse_channels(tokens):
+    lineno, count = tokens.next("the number of channels")
+    if not count.isdigit():
+        raise tokens.error(f"bad number of channels {count!r}", lineno)
+    channels = []
+    for _ in range(int(count)):
+        lineno, word = tokens.next("a channel name")
+        if word not in _BVH_TO_CHANNEL:
+            raise tokens.error(
+                f"unknown channel {word!r}; expected one of {list(_BVH_TO_CHANNEL)}",
+                lineno,
+            )
+        channels.append(_BVH_TO_CHANNEL[word])
+    return tuple(channels)
+
+
+def _bvh_bone(name, parent, offset, channels):
+    length = float(np.linalg.norm(offset))
+    rotation_axes = [c[1] for c in channels if c in EULER_CHANNELS]
+    return Bone(
+        name=name,
+        parent=parent,
+        direction=offset / length if length else np.zeros(3),
+        length=length,
+        channels=channels,
+        rotation_order="".join(reversed(rotation_axes)),
+    )
+
+
+def _split_header(path):
+    """``(header lines, motion lines)``, split at the line that starts with MOTION."""
+    lines = read_lines(path)
+    for i, (_, text) in enumerate(lines):
+        if text.strip().upper().startswith("MOTION"):
+            return lines[:i], lines[i:]
+    lineno = lines[-1][0] if lines else 1
+    raise parse_error(path, lineno, "no 'MOTION' section before the end of the file")
+
+
+def _skeleton_from_header(path, header):
+    bones = _parse_hierarchy(_Tokens(path, header))
+    return Skeleton(
+        bones, name=Path(path).stem, up_axis="y", angle_unit="deg", convention="bvh"
+    )
+
+
+def read_bvh_skeleton(path):
+    """The skeleton of a BVH file; see :meth:`Skeleton.from_bvh`."""
+    header, _ = _split_header(path)
+    return _skeleton_from_header(path, header)
+
+
+def read_bvh(path):
+    """Read a BVH motion file.
+
+    Parameters
+    ----------
+    path : path-like
+        The ``.bvh`` file.
+
+    Returns
+    -------
+    skeleton : Skeleton
+        From the HIERARCHY, ``convention="bvh"``; end sites are bones named
+        ``"{parent}_end"`` without channels.
+    data : ndarray of shape (n_frames, n_features)
+        The MOTION values, positions in file units and angles in degrees.
+    feature_names : ndarray of str
+        ``skeleton.feature_names``: ``"{joint}_{channel}"`` with channels
+        ``tx``, ``ty``, ``tz`` (``Xposition`` ...) and ``rx``, ``ry``, ``rz``
+        (``Xrotation`` ...), in file order.
+    frame_rate : float
+        ``1 / Frame Time``.
+
+    Raises
+    ------
+    ValueError
+        If the file is malformed (no HIERARCHY or MOTION, a bad number, a
+        frame with the wrong number of values, fewer frames than announced);
+        the message names the file and line.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> import numpy as np
+    >>> from sklearn_crbm.datasets import make_walker, read_bvh, write_bvh
+    >>> walker = make_walker(n_sequences=1, n_frames=3, random_state=0)
+    >>> path = os.path.join(tempfile.mkdtemp(), "walk.bvh")
+    >>> write_bvh(path, walker.data, walker.skeleton, walker.frame_rate)
+    >>> skeleton, data, names, frame_rate = read_bvh(path)
+    >>> data.shape, round(frame_rate, 6)
+    ((3, 33), 30.0)
+    """
+    header, motion = _split_header(path)
+    skeleton = _skeleton_from_header(path, header)
+    n_channels = len(skeleton.feature_names)
+    n_frames, frame_time, rows = _parse_motion_header(path, motion)
+    data = _parse_rows(path, rows, n_channels, n_frames, motion[-1][0])
+    return skeleton, data, skeleton.feature_names, 1.0 / frame_time
+
+
+def _parse_motion_header(path, motion):
+    """``(n_frames, frame_time, data lines)`` from the lines after MOTION."""
+    lines = [(n, t.strip()) for n, t in motion[1:] if t.strip()]
+    end_line = motion[-1][0]
+    n_frames = _labelled_number(path, lines, 0, "Frames:", end_line)
+    if n_frames < 0 or not n_frames.is_integer():
+        raise parse_error(
+            path, lines[0][0], f"expected a whole number of frames, got {n_frames!r}"
+        )
+    frame_time = _labelled_number(path, lines, 1, "Frame Time:", end_line)
+    if not frame_time > 0:
+        raise parse_error(
+            path, lines[1][0], f"expected a positive frame time, got {frame_time!r}"
+        )
+    return int(n_frames), frame_time, lines[2:]
+
+
+def _labelled_number(path, lines, k, label, end_line):
+    """The number on line ``k`` of ``lines``, which must read ``label number``."""
+    if k >= len(lines) or not lines[k][1].startswith(label):
+        lineno = lines[k][0] if k < len(lines) else end_line
+        raise parse_error(path, lineno, f"expected '{label} ...' after MOTION")
+    lineno, text = lines[k]
+    tokens = text[len(label) :].split()
+    if len(tokens) != 1:
+        raise parse_error(path, lineno, f"expected one number after {label!r}")
+    return parse_floats(tokens, path, lineno, label)[0]
+
+
+def _parse_rows(path, rows, n_channels, n_frames, last_line):
+    if len(rows) < n_frames:
+        raise parse_error(
+            path,
+            last_line,
+            f"the file has {len(rows)} frames but 'Frames:' announced "
+            f"{n_frames} (truncated file?)",
+        )
+    if len(rows) > n_frames:
+        raise parse_error(
+            path,
+            rows[n_frames][0],
+            f"more frames than the {n_frames} announced by 'Frames:'",
+        )
+    data = np.empty((n_frames, n_channels))
+    for i, (lineno, text) in enumerate(rows):
+        tokens = text.split()
+        if len(tokens) != n_channels:
+            raise parse_error(
+                path, lineno, f"frame has {len(tokens)} values, expected {n_channels}"
+            )
+        data[i] = parse_floats(tokens, path, lineno)
+    return data
+
+
+# ------------------------------------------------------------------ writing
+def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
+    """Write motion as a BVH file for animation tools.
+
+    A bone of a BVH skeleton, or of an ASF skeleton without ``axis``
+    pre-rotation, keeps its Euler channels and values (angles in degrees).
+    Other rotations cannot be written as the same channels in a BVH file:
+    bones with an ASF ``axis`` pre-rotation (most limbs of the CMU
+    skeletons) and exponential maps (MIT data) are written as three channels
+    ``Zrotation Yrotation Xrotation`` holding the bone's rotation relative to
+    its parent, ``C @ M @ C^-1``.  Forward kinematics of what
+    :func:`read_bvh` reads back agrees with the skeleton's.
+
+    For an ASF skeleton every bone becomes a joint at the *start* of the
+    bone, and leaf bones get an end site at their end; so the ASF position of
+    a bone (its end) is the BVH position of its children, or of its end site
+    ``"{bone}_end"``.  MIT offset channels (``ox``, ``oy``, ``oz``) are not
+    written: the joint offsets hold them.  BVH has no up axis; positions are
+    written in the skeleton's own axes (z up for MIT data) and
+    :func:`read_bvh` reports ``up_axis="y"``.
+
+    Parameters
+    ----------
+    path : path-like
+        The file to write.
+    data : array-like of shape (n_frames, n_features)
+        Raw channels.
+    skeleton : Skeleton
+        The skeleton the channels belong to.
+    frame_rate : float
+        Frames per second; the file holds ``Frame Time: 1 / frame_rate``.
+    feature_names : array-like of str, default=None
+        Name of each column of ``data``; default ``skeleton.feature_names``.
+
+    Raises
+    ------
+    ValueError
+        If a channel of the skeleton is missing or a value is not finite.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> from sklearn_crbm.datasets import make_walker, write_bvh
+    >>> walker = make_walker(n_sequences=1, n_frames=3, random_state=0)
+    >>> path = os.path.join(tempfile.mkdtemp(), "walk.bvh")
+    >>> write_bvh(path, walker.data, walker.skeleton, frame_rate=30.0)
+    """
+    if not frame_rate > 0:
+        raise ValueError(f"frame_rate must be positive, got {frame_rate!r}.")
+    roots = [bone.name for bone in skeleton.bones if bone.parent is None]
+    if len(roots) > 1:
+        raise ValueError(f"A BVH file has one ROOT; the skeleton has roots {roots}.")
+    X, columns = skeleton._columns(data, feature_names)
+    if not np.all(
+        np.isfinite(X[:, [columns[n] for n in skeleton._required_channels()]])
+    ):
+        raise ValueError(
+            "data contain NaN or infinite values; fill them before writing."
+        )
+    local = skeleton.local_rotations(
+        X, skeleton.feature_names if feature_names is None else feature_names
+    )
+    joints = _bvh_joints(skeleton)
+    values = np.column_stack(
+        [_joint_values(skeleton, joint, X, columns, local) for joint in joints.values()]
+        or [np.empty((X.shape[0], 0))]
+    )
+    lines = ["HIERARCHY"]
+    _hierarchy_lines(skeleton, joints, skeleton.bones[0].name, 0, lines)
+    lines += [
+        "MOTION",
+        f"Frames: {X.shape[0]}",
+        f"Frame Time: {format_number(1.0 / frame_rate)}",
+    ]
+    lines += [" ".join(format_number(v) for v in row) for row in values]
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def _keeps_channels(skeleton, bone):
+    """Whether the bone's rotation is written as its own Euler channels."""
+    if bone.rotation_type == "expmap":
+        return False
+    return bone.rotation_type == "" or not np.any(bone.axis)
+
+
+def _bvh_joints(skeleton):
+    """Joints to write, in depth-first order, keyed by bone name.
+
+    Each is a dict with the joint ``offset``, its BVH ``channels`` (our short
+    names), whether its rotation is ``baked`` into XYZ Euler angles, and the
+    ``end`` offset of an end site (``None`` when the joint has children).
+    """
+    index = {bone.name: i for i, bone in enumerate(skeleton.bones)}
+    acclaim = skeleton.convention == "acclaim"
+    joints = {}
+    for bone in skeleton.bones:
+        children = skeleton.children(bone.name)
+        if bone.parent is None:
+            offset = bone.offset
+        elif acclaim:
+            parent = skeleton.bones[index[bone.parent]]
+            offset = np.zeros(3) if parent.parent is None else parent.offset
+        else:
+            offset = bone.offset
+        translation = tuple(c for c in bone.channels if c in TRANSLATION_CHANNELS)
+        if _keeps_channels(skeleton, bone):
+            rotation = tuple(f"r{a}" for a in reversed(bone.rotation_order))
+            baked = False
+        else:
+            rotation, baked = ("rz", "ry", "rx"), True
+        end = None
+        if not children:
+            end = bone.offset if acclaim else np.zeros(3)
+        if (
+            not acclaim
+            and not children
+            and not bone.channels
+            and bone.parent is not None
+        ):
+            continue  # a channel-less leaf of a BVH skeleton is its parent's end site
+        joints[bone.name] = {
+            "offset": offset,
+            "channels": translation + rotation,
+            "baked": baked,
+            "end": end,
+        }
+    for bone in skeleton.bones:
+        if bone.name not in joints:
+            joints[bone.parent]["end"] = bone.offset
+    return _depth_first(skeleton, joints)
+
+
+def _depth_first(skeleton, joints):
+    order = []
+
+    def visit(name):
+        order.append(name)
+        for child in skeleton.children(name):
+            if child in joints:
+                visit(child)
+
+    visit(skeleton.bones[0].name)
+    return {name: dict(joints[name], name=name) for name in order}
+
+
+def _joint_values(skeleton, joint, X, columns, local):
+    bone = skeleton.bone(joint["name"])
+    n_frames = X.shape[0]
+    if joint["baked"]:
+        i = skeleton.bone_names.index(bone.name)
+        euler = np.rad2deg(matrix_to_euler(local[:, i], "xyz"))  # columns rx, ry, rz
+        baked = {"rx": euler[:, 0], "ry": euler[:, 1], "rz": euler[:, 2]}
+    out = np.empty((n_frames, len(joint["channels"])))
+    for k, channel in enumerate(joint["channels"]):
+        if joint["baked"] and channel in baked:
+            out[:, k] = baked[channel]
+            continue
+        out[:, k] = X[:, columns[f"{bone.name}_{channel}"]]
+        if channel in EULER_CHANNELS and skeleton.angle_unit == "rad":
+            out[:, k] = np.rad2deg(out[:, k])
+    return out
+
+
+def _hierarchy_lines(skeleton, joints, name, depth, lines):
+    joint = joints[name]
+    pad = "  " * depth
+    keyword = "ROOT" if depth == 0 else "JOINT"
+    channels = " ".join(_CHANNEL_TO_BVH[c] for c in joint["channels"])
+    lines += [
+        f"{pad}{keyword} {name}",
+        f"{pad}{{",
+        f"{pad}  OFFSET {_vector(joint['offset'])}",
+        f"{pad}  CHANNELS {len(joint['channels'])} {channels}".rstrip(),
+    ]
+    for child in skeleton.children(name):
+        if child in joints:
+            _hierarchy_lines(skeleton, joints, child, depth + 1, lines)
+    if joint["end"] is not None:
+        lines += [
+            f"{pad}  End Site",
+            f"{pad}  {{",
+            f"{pad}    OFFSET {_vector(joint['end'])}",
+            f"{pad}  }}",
+        ]
+    lines.append(f"{pad}}}")
+
+
+def _vector(values):
+    """An offset with 12 significant digits: ``length * direction`` is only
+    exact to rounding, and this keeps a read-write cycle stable."""
+    return " ".join(format_number(float(f"{v:.12g}")) for v in values)

@@ -1,0 +1,489 @@
+"""Skeletons: bones, their channels, and forward kinematics.
+
+A :class:`Skeleton` describes how the raw channels of a motion-capture file
+(root translation, Euler angles or exponential maps per bone) turn into 3-D
+joint positions.  It is built from an Acclaim ASF file, from the header of a
+BVH file, or from the ``skel`` structure of Graham Taylor's MIT data.
+
+Two conventions place the bones:
+
+``"acclaim"`` (ASF/AMC)
+    Every bone is a segment that starts where its parent ends.  Its rest
+    direction is given in the global frame.  The global rotation of a bone is
+    ``R = R_parent @ C @ M @ C^-1``, with ``C`` the ASF ``axis`` pre-rotation
+    and ``M`` the rotation of the bone's channels, and the bone's end lies at
+    ``position_parent + length * R @ direction``.
+
+``"bvh"`` (BVH and Taylor's MIT data)
+    Every bone is a joint placed at an offset from its parent, expressed in the
+    parent's frame: ``position = position_parent + R_parent @ offset``, and
+    ``R = R_parent @ M``.
+
+In both, the root is placed at its offset plus its translation channels.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..utils._rotations import euler_to_matrix, expmap_to_matrix
+
+__all__ = ["Bone", "Skeleton"]
+
+EULER_CHANNELS = ("rx", "ry", "rz")
+EXPMAP_CHANNELS = ("ex", "ey", "ez")
+TRANSLATION_CHANNELS = ("tx", "ty", "tz")
+OFFSET_CHANNELS = ("ox", "oy", "oz")
+KNOWN_CHANNELS = (
+    EULER_CHANNELS + EXPMAP_CHANNELS + TRANSLATION_CHANNELS + OFFSET_CHANNELS
+)
+
+ANGLE_UNITS = ("deg", "rad")
+CONVENTIONS = ("acclaim", "bvh")
+
+
+@dataclass
+class Bone:
+    """One bone (or joint) of a :class:`Skeleton`.
+
+    Parameters
+    ----------
+    name : str
+        Bone name, unique within its skeleton (``"lfemur"``).
+    parent : str or None
+        Name of the parent bone; ``None`` for the root.
+    direction : array-like of shape (3,)
+        Direction of the bone offset, normalised to a unit vector (ASF files
+        print it to about six digits).  ASF: the global direction of the bone
+        at rest.  BVH and MIT: ``offset / |offset|`` in the parent's frame.
+    length : float
+        Length of the offset.
+    channels : tuple of str
+        The bone's values, in the order they appear in the data: ``"tx"``,
+        ``"ty"``, ``"tz"`` (translation), ``"rx"``, ``"ry"``, ``"rz"`` (Euler
+        angles), ``"ex"``, ``"ey"``, ``"ez"`` (exponential map) and ``"ox"``,
+        ``"oy"``, ``"oz"`` (per-frame copies of the offset, MIT data only; forward
+        kinematics uses ``length * direction`` instead).
+    rotation_order : str, default=""
+        The axes of the Euler channels in the order they are *applied* to a
+        vector (first applied first): ASF ``dof rx ry rz`` is ``"xyz"``; BVH
+        ``Zrotation Xrotation Yrotation`` (``R = Rz Rx Ry``) is ``"yxz"``.
+        Empty when the bone has no Euler channels.
+    axis : array-like of shape (3,), default=(0, 0, 0)
+        ASF ``axis`` pre-rotation in degrees (for an ASF root, its
+        ``orientation``); zeros for BVH and MIT.
+    axis_order : str, default="xyz"
+        Order in which the ``axis`` angles are applied.
+    """
+
+    name: str
+    parent: str | None
+    direction: np.ndarray
+    length: float
+    channels: tuple[str, ...] = ()
+    rotation_order: str = ""
+    axis: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    axis_order: str = "xyz"
+
+    def __post_init__(self):
+        direction = np.asarray(self.direction, dtype=np.float64).reshape(3)
+        norm = np.linalg.norm(direction)
+        self.direction = direction / norm if norm > 0 else direction
+        self.length = float(self.length)
+        self.channels = tuple(str(c) for c in self.channels)
+        self.rotation_order = str(self.rotation_order).lower()
+        self.axis = np.asarray(self.axis, dtype=np.float64).reshape(3)
+        self.axis_order = str(self.axis_order).lower()
+        _check_bone_channels(self)
+
+    @property
+    def offset(self):
+        """``length * direction``, shape (3,)."""
+        return self.length * self.direction
+
+    @property
+    def rotation_type(self):
+        """``"euler"``, ``"expmap"`` or ``""`` (no rotation channels)."""
+        if any(c in EULER_CHANNELS for c in self.channels):
+            return "euler"
+        if any(c in EXPMAP_CHANNELS for c in self.channels):
+            return "expmap"
+        return ""
+
+
+def _check_bone_channels(bone):
+    unknown = [c for c in bone.channels if c not in KNOWN_CHANNELS]
+    if unknown:
+        raise ValueError(
+            f"Bone {bone.name!r} has unknown channels {unknown}; known channels "
+            f"are {list(KNOWN_CHANNELS)}."
+        )
+    if len(set(bone.channels)) != len(bone.channels):
+        raise ValueError(f"Bone {bone.name!r} repeats a channel: {bone.channels}.")
+    euler_axes = sorted(c[1] for c in bone.channels if c in EULER_CHANNELS)
+    if sorted(bone.rotation_order) != euler_axes:
+        raise ValueError(
+            f"Bone {bone.name!r}: rotation_order {bone.rotation_order!r} must name "
+            f"exactly the axes of its Euler channels {euler_axes}."
+        )
+    expmap = [c for c in bone.channels if c in EXPMAP_CHANNELS]
+    if expmap and (euler_axes or len(expmap) != 3):
+        raise ValueError(
+            f"Bone {bone.name!r}: an exponential map needs all of ex, ey, ez and "
+            "no Euler channels."
+        )
+
+
+class Skeleton:
+    """The bones of a motion-capture subject and how channels move them.
+
+    Parameters
+    ----------
+    bones : list of Bone
+        The root first, every parent before its children, in the order of
+        the bones' channels in the data.  (Further bones without a parent are
+        allowed, e.g. for a bare list of joints; each is placed like a root.)
+    name : str, default="skeleton"
+        A name for the skeleton.
+    up_axis : {"x", "y", "z"}, default="y"
+        The vertical axis: ``"y"`` for CMU and BVH data, ``"z"`` for MIT.
+    angle_unit : {"deg", "rad"}, default="deg"
+        Unit of the Euler channels.  Exponential maps are always in radians
+        and ``axis`` pre-rotations always in degrees.
+    length_scale : float, default=1.0
+        The file's length unit (ASF ``:units length``), kept for reference;
+        lengths and positions are in the file's units.
+    convention : {"acclaim", "bvh"}, default="acclaim"
+        How bone offsets and rotations compose (see the module docstring):
+        ``"acclaim"`` for ASF skeletons, ``"bvh"`` for BVH and MIT.
+
+    Attributes
+    ----------
+    bones : list of Bone
+        The bones.
+    feature_names : ndarray of str
+        ``"{bone}_{channel}"`` for every channel, in data order.
+
+    Examples
+    --------
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> walker = make_walker(n_sequences=1, n_frames=5, random_state=0)
+    >>> skeleton = walker.skeleton
+    >>> skeleton.feature_names[:4]
+    array(['root_tx', 'root_ty', 'root_tz', 'root_rx'], dtype=object)
+    >>> skeleton.forward_kinematics(walker.data).shape
+    (5, 18, 3)
+    """
+
+    def __init__(
+        self,
+        bones,
+        *,
+        name="skeleton",
+        up_axis="y",
+        angle_unit="deg",
+        length_scale=1.0,
+        convention="acclaim",
+    ):
+        self.name = str(name)
+        self.bones = list(bones)
+        self.up_axis = str(up_axis).lower()
+        self.angle_unit = str(angle_unit).lower()
+        self.length_scale = float(length_scale)
+        self.convention = str(convention).lower()
+        self._check()
+        self._index = {bone.name: i for i, bone in enumerate(self.bones)}
+
+    def _check(self):
+        if self.up_axis not in ("x", "y", "z"):
+            raise ValueError(f"up_axis must be 'x', 'y' or 'z', got {self.up_axis!r}.")
+        if self.angle_unit not in ANGLE_UNITS:
+            raise ValueError(
+                f"angle_unit must be 'deg' or 'rad', got {self.angle_unit!r}."
+            )
+        if self.convention not in CONVENTIONS:
+            raise ValueError(
+                f"convention must be one of {CONVENTIONS}, got {self.convention!r}."
+            )
+        if not self.bones:
+            raise ValueError("A skeleton needs at least one bone.")
+        if self.bones[0].parent is not None:
+            raise ValueError(
+                f"The first bone must be the root (parent None), got "
+                f"{self.bones[0].name!r} with parent {self.bones[0].parent!r}."
+            )
+        seen = set()
+        for bone in self.bones:
+            if bone.name in seen:
+                raise ValueError(f"Bone name {bone.name!r} occurs twice.")
+            if bone.parent is not None and bone.parent not in seen:
+                raise ValueError(
+                    f"Bone {bone.name!r} comes before its parent {bone.parent!r} "
+                    "(or the parent does not exist); list parents before children."
+                )
+            seen.add(bone.name)
+
+    def __repr__(self):
+        return (
+            f"Skeleton(name={self.name!r}, n_bones={len(self.bones)}, "
+            f"n_channels={len(self.feature_names)}, up_axis={self.up_axis!r}, "
+            f"angle_unit={self.angle_unit!r}, convention={self.convention!r})"
+        )
+
+    # ------------------------------------------------------------------ lookup
+    def bone(self, name):
+        """The bone called ``name``.
+
+        Raises
+        ------
+        ValueError
+            If the skeleton has no such bone.
+        """
+        try:
+            return self.bones[self._index[name]]
+        except KeyError:
+            raise ValueError(
+                f"Skeleton {self.name!r} has no bone {name!r}; its bones are "
+                f"{self.bone_names}."
+            ) from None
+
+    @property
+    def bone_names(self):
+        """Names of the bones, in order."""
+        return [bone.name for bone in self.bones]
+
+    @property
+    def parent_indices(self):
+        """Index of each bone's parent in :attr:`bones` (``-1`` for the root)."""
+        return np.array(
+            [-1 if b.parent is None else self._index[b.parent] for b in self.bones],
+            dtype=np.intp,
+        )
+
+    def children(self, name):
+        """Names of the bones whose parent is ``name``."""
+        self.bone(name)
+        return [bone.name for bone in self.bones if bone.parent == name]
+
+    @property
+    def feature_names(self):
+        """``"{bone}_{channel}"`` for every channel of every bone, in data order."""
+        return np.array(
+            [f"{bone.name}_{c}" for bone in self.bones for c in bone.channels],
+            dtype=object,
+        )
+
+    # ------------------------------------------------------ forward kinematics
+    def forward_kinematics(self, data, feature_names=None):
+        """Joint positions from raw channels.
+
+        Parameters
+        ----------
+        data : array-like of shape (n_frames, n_features)
+            Raw channels: root translation in the skeleton's length unit,
+            Euler angles in :attr:`angle_unit`, exponential maps in radians.
+        feature_names : array-like of str, default=None
+            Name of each column of ``data``; default :attr:`feature_names`.
+            Columns the skeleton does not use are ignored.
+
+        Returns
+        -------
+        positions : ndarray of shape (n_frames, n_bones, 3)
+            For ``"acclaim"`` skeletons the root position and the *end* of
+            every bone; for ``"bvh"`` skeletons the position of every joint.
+
+        Raises
+        ------
+        ValueError
+            If a rotation or translation channel of the skeleton is missing
+            from ``feature_names`` (the message names them).
+        """
+        positions, _ = self._global_transforms(data, feature_names)
+        return positions
+
+    def global_rotations(self, data, feature_names=None):
+        """Global rotation matrix of every bone, shape (n_frames, n_bones, 3, 3).
+
+        Same parameters as :meth:`forward_kinematics`.
+        """
+        _, rotations = self._global_transforms(data, feature_names)
+        return rotations
+
+    def local_rotations(self, data, feature_names=None):
+        """Rotation of every bone relative to its parent, (n_frames, n_bones, 3, 3).
+
+        For ``"acclaim"`` skeletons this includes the ``axis`` pre-rotation,
+        ``C @ M @ C^-1``; it is the rotation a BVH joint at the start of the
+        bone would carry.  Same parameters as :meth:`forward_kinematics`.
+        """
+        X, columns = self._columns(data, feature_names)
+        return np.stack(
+            [self._local_rotation(bone, X, columns) for bone in self.bones], axis=1
+        )
+
+    def _global_transforms(self, data, feature_names):
+        X, columns = self._columns(data, feature_names)
+        n_frames, n_bones = X.shape[0], len(self.bones)
+        positions = np.empty((n_frames, n_bones, 3))
+        rotations = np.empty((n_frames, n_bones, 3, 3))
+        for i, (bone, parent) in enumerate(
+            zip(self.bones, self.parent_indices, strict=True)
+        ):
+            local = self._local_rotation(bone, X, columns)
+            offset = bone.offset + self._translation(bone, X, columns)
+            if parent < 0:
+                rotations[:, i] = local
+                positions[:, i] = offset
+                continue
+            rotations[:, i] = rotations[:, parent] @ local
+            frame = (
+                rotations[:, i]
+                if self.convention == "acclaim"
+                else rotations[:, parent]
+            )
+            positions[:, i] = positions[:, parent] + np.einsum(
+                "nij,nj->ni", frame, offset
+            )
+        return positions, rotations
+
+    def _required_channels(self):
+        """Feature names that forward kinematics reads (all but MIT offsets)."""
+        return [
+            f"{bone.name}_{c}"
+            for bone in self.bones
+            for c in bone.channels
+            if c not in OFFSET_CHANNELS
+        ]
+
+    def _columns(self, data, feature_names):
+        X = np.asarray(data, dtype=np.float64)
+        if X.ndim != 2:
+            raise ValueError(
+                f"data must be 2-D (n_frames, n_features), got shape {X.shape}."
+            )
+        names = self.feature_names if feature_names is None else feature_names
+        columns = column_indices(names, self._required_channels(), n_columns=X.shape[1])
+        return X, columns
+
+    def _angles(self, X, columns, bone, channel_names):
+        cols = [columns[f"{bone.name}_{c}"] for c in channel_names]
+        return X[:, cols]
+
+    def _local_rotation(self, bone, X, columns):
+        n_frames = X.shape[0]
+        kind = bone.rotation_type
+        if kind == "euler":
+            angles = self._angles(
+                X, columns, bone, [f"r{a}" for a in bone.rotation_order]
+            )
+            if self.angle_unit == "deg":
+                angles = np.deg2rad(angles)
+            M = euler_to_matrix(angles, bone.rotation_order)
+        elif kind == "expmap":
+            M = expmap_to_matrix(self._angles(X, columns, bone, EXPMAP_CHANNELS))
+        else:
+            M = np.broadcast_to(np.eye(3), (n_frames, 3, 3))
+        if np.any(bone.axis):
+            C = euler_to_matrix(np.deg2rad(bone.axis), bone.axis_order)
+            M = C @ M @ C.T
+        return M
+
+    def _translation(self, bone, X, columns):
+        t = np.zeros((X.shape[0], 3))
+        for k, c in enumerate(TRANSLATION_CHANNELS):
+            if c in bone.channels:
+                t[:, k] = X[:, columns[f"{bone.name}_{c}"]]
+        return t
+
+    # ------------------------------------------------------------ constructors
+    @classmethod
+    def from_asf(cls, path):
+        """Read an Acclaim ASF skeleton file (e.g. CMU ``35.asf``).
+
+        Raises
+        ------
+        ValueError
+            If the file is malformed; the message names the file and line.
+        """
+        from ._acclaim import read_asf
+
+        return read_asf(path)
+
+    @classmethod
+    def from_bvh(cls, path):
+        """Read the skeleton from the HIERARCHY of a BVH file.
+
+        End sites become bones named ``"{parent}_end"`` without channels.
+
+        Raises
+        ------
+        ValueError
+            If the file is malformed; the message names the file and line.
+        """
+        from ._bvh import read_bvh_skeleton
+
+        return read_bvh_skeleton(path)
+
+    @classmethod
+    def from_mit(cls, skel, offsets=None):
+        """The skeleton of Graham Taylor's MIT walking data.
+
+        Parameters
+        ----------
+        skel : path-like or MATLAB struct
+            A path to a ``.mat`` file with ``skel`` (and ``Motion``), or the
+            ``skel`` struct as loaded by :func:`scipy.io.loadmat`.
+        offsets : array-like of shape (108,), default=None
+            One frame of MIT data, whose offset columns give the bone
+            offsets.  Default: the first frame of ``Motion`` when ``skel`` is
+            a path; otherwise the offsets are unknown (zero length) and
+            :meth:`forward_kinematics` places every joint at the root.
+
+        Returns
+        -------
+        skeleton : Skeleton
+            ``convention="bvh"``, ``up_axis="z"``, ``angle_unit="rad"``.  See
+            :func:`~sklearn_crbm.datasets.load_mit_walk` for the bone names.
+        """
+        from ._mit import read_mit_skeleton
+
+        return read_mit_skeleton(skel, offsets)
+
+
+def column_indices(feature_names, required, *, n_columns=None):
+    """Map each required feature name to its column.
+
+    Parameters
+    ----------
+    feature_names : array-like of str
+        Name of every column.
+    required : list of str
+        Names that must be present.
+    n_columns : int, default=None
+        Expected number of columns, checked when given.
+
+    Returns
+    -------
+    columns : dict
+        ``name -> column index`` for every name in ``feature_names``.
+
+    Raises
+    ------
+    ValueError
+        If a required name is missing (all missing names are listed), a name
+        repeats, or the number of names does not match ``n_columns``.
+    """
+    names = [str(n) for n in np.asarray(feature_names, dtype=object).ravel()]
+    if n_columns is not None and len(names) != n_columns:
+        raise ValueError(
+            f"Got {len(names)} feature names for data with {n_columns} columns."
+        )
+    columns = {}
+    for i, name in enumerate(names):
+        if name in columns:
+            raise ValueError(f"Feature name {name!r} occurs more than once.")
+        columns[name] = i
+    missing = [name for name in required if name not in columns]
+    if missing:
+        raise ValueError(f"The data lack these channels of the skeleton: {missing}.")
+    return columns
