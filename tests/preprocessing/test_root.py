@@ -1,0 +1,228 @@
+"""RootRelativeEncoder: global root <-> body-centred root."""
+
+import pickle
+
+import numpy as np
+import pytest
+import scipy.io
+
+from sklearn_crbm.datasets import load_cmu35, load_mit_walk, make_walker
+from sklearn_crbm.preprocessing import ExpMapEncoder, RootRelativeEncoder
+from sklearn_crbm.utils._rotations import expmap_to_matrix
+
+ROOT_OUT = [
+    "root_pitch",
+    "root_roll",
+    "root_dheading",
+    "root_dforward",
+    "root_dsideways",
+    "root_height",
+]
+
+
+@pytest.fixture(scope="module")
+def mit(data_home):
+    return load_mit_walk(data_home)
+
+
+@pytest.fixture(scope="module")
+def cmu_expmap(data_home):
+    cmu = load_cmu35(data_home)
+    encoder = ExpMapEncoder(cmu.skeleton).fit(cmu.data)
+    return cmu, encoder.transform(cmu.data), encoder.get_feature_names_out()
+
+
+def _align_and_compare(original, back, ids, position_cols, expmap_cols, up):
+    """Max errors of orientation and trajectory once each sequence's start pose
+    (heading and ground position) is aligned with the original's."""
+    rot_err = pos_err = 0.0
+    for s in np.unique(ids):
+        o, b = original[ids == s], back[ids == s]
+        Ro, Rb = (
+            expmap_to_matrix(o[:, expmap_cols]),
+            expmap_to_matrix(b[:, expmap_cols]),
+        )
+        Q = Ro[0] @ Rb[0].T  # a rotation about the vertical only
+        assert np.allclose(Q[:, up], np.eye(3)[up], atol=1e-12)
+        rot_err = max(rot_err, np.abs(Q @ Rb - Ro).max())
+        po, pb = o[:, position_cols], b[:, position_cols]
+        aligned = (pb - pb[0]) @ Q.T + po[0]
+        pos_err = max(pos_err, np.abs(aligned - po).max())
+    return rot_err, pos_err
+
+
+def test_mit_equals_taylors_motion_mat(mit, data_home):
+    """Taylor's motion.mat is preprocess1(data.mat Motion[::4]); columns 1-6 are
+    tilt forward, tilt left, d heading, d forward, d sideways, height."""
+    motion = scipy.io.loadmat(data_home / "taylor_theano_motion" / "motion.mat")
+    expected = np.vstack([m for m in motion["Motion"].flat])
+    encoder = RootRelativeEncoder(mit.skeleton)
+    Z = encoder.fit_transform(mit.data, sequence_ids=mit.sequence_ids)
+    assert encoder.up_axis_ == "z"
+    assert list(encoder.get_feature_names_out()[:6]) == ROOT_OUT
+    assert Z.shape == expected.shape == (3826, 108)
+    assert np.abs(Z - expected).max() < 1e-12
+    assert np.array_equal(Z[:, 6:], mit.data[:, 6:])
+
+
+def test_mit_round_trip(mit):
+    encoder = RootRelativeEncoder(mit.skeleton).fit(mit.data)
+    ids = mit.sequence_ids
+    back = encoder.inverse_transform(
+        encoder.transform(mit.data, sequence_ids=ids), sequence_ids=ids
+    )
+    assert np.array_equal(back[:, 6:], mit.data[:, 6:])
+    assert np.abs(back[:, 5] - mit.data[:, 5]).max() < 1e-12  # height is absolute
+    # the documented start pose: heading 0 and ground position (0, 0)
+    starts = np.flatnonzero(np.diff(ids, prepend=-1))
+    assert np.all(back[starts][:, 3:5] == 0.0)
+    forward = expmap_to_matrix(back[starts, :3])[:, :, 0]
+    assert np.allclose(forward[:, 1], 0.0, atol=1e-15) and np.all(forward[:, 0] > 0)
+    rot_err, pos_err = _align_and_compare(
+        mit.data, back, ids, [3, 4, 5], [0, 1, 2], up=2
+    )
+    assert rot_err < 1e-12
+    assert pos_err < 1e-9  # mm, after up to 3128 integrated steps
+
+
+def test_cmu_round_trip_y_up(cmu_expmap):
+    cmu, Z, names = cmu_expmap
+    names = list(names)
+    encoder = RootRelativeEncoder(cmu.skeleton)
+    ids = cmu.sequence_ids
+    E = encoder.fit_transform(Z, sequence_ids=ids)
+    assert encoder.up_axis_ == "y"
+    assert list(encoder.get_feature_names_out()) == ROOT_OUT + names[6:]
+    # upright, walking forward along the body's z axis
+    assert np.all(np.abs(E[:, 0] - np.pi / 2) < 0.3)
+    assert np.all(np.abs(E[:, 1] - np.pi / 2) < 0.3)
+    assert np.median(E[:, 3]) > 0.3 and np.abs(np.median(E[:, 4])) < 0.1
+    assert np.array_equal(E[:, 5], Z[:, 1])
+    back = encoder.inverse_transform(E, sequence_ids=ids)
+    rot_err, pos_err = _align_and_compare(Z, back, ids, [0, 1, 2], [3, 4, 5], up=1)
+    assert rot_err < 1e-12
+    assert pos_err < 1e-10
+
+
+@pytest.mark.parametrize("up", ["x", "y"])
+def test_up_axis_is_a_cyclic_relabelling(mit, up):
+    """The same motion written with another vertical gives the same encoding."""
+    u = "xyz".index(up)
+    perm = np.array([(u + 1) % 3, (u + 2) % 3, u])  # new axis -> old z-up axis
+    inv = np.argsort(perm)  # old axis i is stored in column inv[i]
+    X = mit.data[:200].copy()
+    moved = X.copy()
+    moved[:, 3:6] = X[:, 3:6][:, inv]
+    moved[:, 0:3] = X[:, 0:3][:, inv]  # a proper relabelling maps exp maps alike
+    z_up = RootRelativeEncoder(up_axis="z", root="root")
+    reference = z_up.fit(X[:, :6][:, [3, 4, 5, 0, 1, 2]]).transform(
+        X[:, :6][:, [3, 4, 5, 0, 1, 2]]
+    )
+    other = RootRelativeEncoder(up_axis=up).fit(moved[:, :6][:, [3, 4, 5, 0, 1, 2]])
+    assert np.allclose(
+        other.transform(moved[:, :6][:, [3, 4, 5, 0, 1, 2]]), reference, atol=1e-12
+    )
+
+
+def test_sequences_are_encoded_independently(mit):
+    encoder = RootRelativeEncoder(mit.skeleton).fit(mit.data)
+    ids = mit.sequence_ids
+    whole = encoder.transform(mit.data, sequence_ids=ids)
+    for s in np.unique(ids):
+        alone = encoder.transform(mit.data[ids == s])
+        assert np.array_equal(whole[ids == s], alone)
+    # The last frame of every sequence repeats the deltas of the frame before
+    last = np.flatnonzero(np.diff(ids, append=-1))
+    assert np.array_equal(whole[last, 2:5], whole[last - 1, 2:5])
+    # ... which differs from running across the boundaries
+    joined = encoder.transform(mit.data)
+    assert not np.allclose(joined[last[:-1], 2:5], whole[last[:-1], 2:5])
+
+
+def test_a_one_frame_sequence_has_zero_deltas():
+    walker = make_walker(n_sequences=1, n_frames=10, random_state=0)
+    X = ExpMapEncoder(walker.skeleton).fit_transform(walker.data)
+    ids = np.array([0] * 9 + [1])
+    encoder = RootRelativeEncoder(walker.skeleton).fit(X)
+    E = encoder.transform(X, sequence_ids=ids)
+    assert np.array_equal(E[9, 2:5], np.zeros(3))
+    back = encoder.inverse_transform(E, sequence_ids=ids)
+    assert np.array_equal(back[9, [0, 2]], [0.0, 0.0])
+
+
+def test_step_of_a_simple_walk():
+    # y up; the body turns 90 degrees to its left (about +y) at frame 2
+    X = np.zeros((4, 6))
+    X[:, 1] = 10.0
+    X[:, 2] = [0.0, 1.0, 2.0, 2.0]  # tz: forward along +z ...
+    X[3, 0] = 1.0  # ... then one step along +x, the body's left before turning
+    X[2:, 4] = np.pi / 2  # root exp map about y: now facing +x
+    E = RootRelativeEncoder(up_axis="y").fit_transform(X)
+    assert np.allclose(E[:, 2], [0.0, np.pi / 2, 0.0, 0.0])  # d heading
+    assert np.allclose(E[:, 3], [1.0, 1.0, 1.0, 1.0])  # d forward
+    assert np.allclose(E[:, 4], 0.0)  # d sideways
+    X2 = X.copy()
+    X2[3, [0, 2]] = [2.0, 3.0]  # side step to the right after the turn
+    E2 = RootRelativeEncoder(up_axis="y").fit_transform(X2)
+    assert np.allclose(E2[2, 3:5], [2.0, 1.0])  # forward 2, 1 to the right
+
+
+def test_unnamed_array_uses_the_first_six_columns():
+    walker = make_walker(n_sequences=1, n_frames=20, random_state=1)
+    X = ExpMapEncoder(walker.skeleton).fit_transform(walker.data)
+    with_skeleton = RootRelativeEncoder(walker.skeleton).fit(X).transform(X)
+    positional = RootRelativeEncoder(up_axis="y").fit(X)
+    assert np.array_equal(positional.transform(X), with_skeleton)
+    assert list(positional.get_feature_names_out()[:7]) == ROOT_OUT + ["x6"]
+    assert positional.root_columns_.tolist() == [0, 1, 2, 3, 4, 5]
+
+
+def test_estimator_basics_on_root_data():
+    """What sklearn's common checks cannot test here (their data has fewer than
+    six columns): fit returns self, idempotence, pickling, input containers."""
+    walker = make_walker(n_sequences=2, n_frames=15, random_state=2)
+    X = ExpMapEncoder(walker.skeleton).fit_transform(walker.data)
+    encoder = RootRelativeEncoder(walker.skeleton)
+    assert encoder.fit(X) is encoder
+    first = encoder.transform(X)
+    assert np.array_equal(encoder.fit(X).transform(X), first)
+    clone = pickle.loads(pickle.dumps(encoder))
+    assert np.array_equal(clone.transform(X), first)
+    assert np.array_equal(encoder.transform(X.tolist()), first)
+    assert np.array_equal(encoder.transform(np.asfortranarray(X)), first)
+    assert np.array_equal(encoder.transform(X.astype(np.float32)).dtype, np.float64)
+    readonly = X.copy()
+    readonly.setflags(write=False)
+    assert np.array_equal(encoder.transform(readonly), first)
+    assert encoder.n_features_in_ == X.shape[1]
+    assert encoder.get_params() == RootRelativeEncoder(walker.skeleton).get_params()
+
+
+def test_missing_root_channels_raise(cmu_expmap):
+    cmu, Z, _ = cmu_expmap
+    with pytest.raises(ValueError, match=r"lacks the root channels \['pelvis_tx'"):
+        RootRelativeEncoder(cmu.skeleton, root="pelvis").fit(Z)
+    with pytest.raises(ValueError, match="3 feature"):
+        RootRelativeEncoder().fit(Z[:, :3])
+
+
+def test_raw_euler_layout_raises(cmu_expmap):
+    cmu, _, _ = cmu_expmap
+    with pytest.raises(ValueError, match="after ExpMapEncoder, are 90"):
+        RootRelativeEncoder(cmu.skeleton).fit(cmu.data)
+
+
+def test_wrong_column_count_at_transform_raises(cmu_expmap):
+    cmu, Z, _ = cmu_expmap
+    encoder = RootRelativeEncoder(cmu.skeleton).fit(Z)
+    with pytest.raises(ValueError, match="X has 89 features"):
+        encoder.transform(Z[:, :89])
+    with pytest.raises(ValueError, match="expects 90 features"):
+        encoder.inverse_transform(Z[:, :89])
+    with pytest.raises(ValueError, match="more than one contiguous run"):
+        encoder.transform(Z[:4], sequence_ids=[0, 1, 0, 1])
+
+
+def test_bad_up_axis_raises():
+    with pytest.raises(ValueError, match="up_axis"):
+        RootRelativeEncoder(up_axis="w").fit(np.zeros((3, 6)))
