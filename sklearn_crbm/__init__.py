@@ -1,11 +1,37 @@
 """Conditional Restricted Boltzmann Machines for human motion, for scikit-learn.
 
 A scikit-learn compatible implementation of Taylor, Hinton & Roweis,
-"Modeling Human Motion Using Binary Latent Variables" (NIPS 2006).
+"Modeling Human Motion Using Binary Latent Variables" (NIPS 2006): the
+conditional RBM and its two-level stack, the paper's motion-capture
+preprocessing, on-line filling in of missing channels, and generation.
 """
 
+from . import datasets, metrics, plotting, preprocessing
 from ._crbm import ConditionalRBM, TrainingDivergedError
+from ._stacked import StackedCRBM
+from .impute import CRBMImputer, NearestNeighborImputer
+from .preprocessing import (
+    ExpMapEncoder,
+    RootRelativeEncoder,
+    StandardScaler,
+    make_motion_preprocessor,
+)
 
 __version__ = "0.1.0.dev0"
 
-__all__ = ["ConditionalRBM", "TrainingDivergedError", "__version__"]
+__all__ = [
+    "CRBMImputer",
+    "ConditionalRBM",
+    "ExpMapEncoder",
+    "NearestNeighborImputer",
+    "RootRelativeEncoder",
+    "StackedCRBM",
+    "StandardScaler",
+    "TrainingDivergedError",
+    "__version__",
+    "datasets",
+    "make_motion_preprocessor",
+    "metrics",
+    "plotting",
+    "preprocessing",
+]

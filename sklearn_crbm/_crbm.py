@@ -20,6 +20,7 @@ from sklearn.utils.validation import (
 
 from ._crbm_math import (
     BINARY,
+    CDWorkspace,
     CRBMParameters,
     cd_gradients,
     dynamic_biases,
@@ -28,6 +29,7 @@ from ._crbm_math import (
     hidden_probabilities,
     mean_field_prediction,
 )
+from .utils._fitting import unfitted_on_error
 from .utils._sequences import (
     balanced_batches,
     check_sequence_ids,
@@ -103,6 +105,20 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
         from each consecutive chunk of the data, so it draws evenly from all
         sequences and holds no neighbouring frames.  ``"shuffled"``: the
         released code's scheme, all trainable frames shuffled each epoch.
+    history_noise : float, default=0.0
+        Standard deviation of Gaussian noise added, during training only, to
+        the past frames that feed the directed connections (in the units of
+        ``X``; the frame being modelled stays clean).  ``0`` is the paper's
+        schedule.  A model trained on clean histories predicts one step
+        ahead well but, when it generates, its own small errors feed back
+        through the directed connections (mostly near-unit-root
+        autoregressive weights) and the generated motion drifts: a walk
+        speeds up into a jog or freezes, differently for every training
+        seed.  Noisy histories teach it to pull a perturbed past back
+        towards the data and to carry the style in its hidden units, which
+        keeps long generated sequences in their style; 0.8 for standardised
+        motion (see ``benchmarks/generation_styles.py``), at the price of a
+        slightly larger one-step prediction error.
     n_iter : int, default=200
         Number of epochs (passes over the trainable frames).
     random_state : int, RandomState instance or None, default=None
@@ -188,10 +204,14 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
         "cd_steps": [Interval(Integral, 1, None, closed="left")],
         "batch_size": [Interval(Integral, 1, None, closed="left")],
         "batching": [StrOptions({"balanced", "shuffled"})],
+        "history_noise": [Interval(Real, 0, None, closed="left")],
         "n_iter": [Interval(Integral, 1, None, closed="left")],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
     }
+
+    # Private state that a failed fit must forget with the fitted attributes.
+    _training_state = ("_velocities",)
 
     # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
     # search passes ``sequence_ids`` to these methods without being asked.
@@ -214,6 +234,7 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
         cd_steps=1,
         batch_size=100,
         batching="balanced",
+        history_noise=0.0,
         n_iter=200,
         random_state=None,
         verbose=0,
@@ -229,6 +250,7 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
         self.cd_steps = cd_steps
         self.batch_size = batch_size
         self.batching = batching
+        self.history_noise = history_noise
         self.n_iter = n_iter
         self.random_state = random_state
         self.verbose = verbose
@@ -253,12 +275,13 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
         self : ConditionalRBM
             The fitted model.
         """
-        X = validate_data(self, X, dtype=[np.float64, np.float32], reset=True)
-        sequences, frames = self._check_sequences(X, sequence_ids)
-        self.random_state_ = check_random_state(self.random_state)
-        self._initialize(X.shape[1], X.dtype)
-        self._train(X, frames, self.n_iter)
-        self.seed_windows_ = self._pick_seed_windows(X, sequences)
+        with unfitted_on_error(self):
+            X = validate_data(self, X, dtype=[np.float64, np.float32], reset=True)
+            sequences, frames = self._check_sequences(X, sequence_ids)
+            self.random_state_ = check_random_state(self.random_state)
+            self._initialize(X.shape[1], X.dtype)
+            self._train(X, frames, self.n_iter)
+            self.seed_windows_ = self._pick_seed_windows(X, sequences)
         return self
 
     @_fit_context(prefer_skip_nested_validation=True)
@@ -283,17 +306,22 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
             The updated model.
         """
         first_call = not hasattr(self, "components_")
-        X = validate_data(
-            self,
-            X,
-            dtype=[np.float64, np.float32] if first_call else self.components_.dtype,
-            reset=first_call,
-        )
-        sequences, frames = self._check_sequences(X, sequence_ids)
-        if first_call:
-            self.random_state_ = check_random_state(self.random_state)
-            self._initialize(X.shape[1], X.dtype)
-        self._train(X, frames, 1)
+        # bad input leaves a fitted model as it was; divergence unfits it
+        with unfitted_on_error(self, Exception if first_call else ()):
+            X = validate_data(
+                self,
+                X,
+                dtype=[np.float64, np.float32]
+                if first_call
+                else self.components_.dtype,
+                reset=first_call,
+            )
+            sequences, frames = self._check_sequences(X, sequence_ids)
+        with unfitted_on_error(self):
+            if first_call:
+                self.random_state_ = check_random_state(self.random_state)
+                self._initialize(X.shape[1], X.dtype)
+            self._train(X, frames, 1)
         new_windows = self._pick_seed_windows(X, sequences)
         if not first_call:
             new_windows = self._merge_seed_windows(self.seed_windows_, new_windows)
@@ -385,39 +413,64 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
 
     def _train(self, X, frames, n_epochs):
         params = self._params()
-        velocities = self._velocities
+        # W, the directed weights and their velocities in Fortran order: the
+        # matrix products of these shapes run faster in BLAS's orientation
+        # for it (several per cent per epoch); stored back in C order.
+        params.weights = np.asfortranarray(params.weights)
+        params.dynamic = np.asfortranarray(params.dynamic)
+        self._velocities = velocities = [np.asfortranarray(v) for v in self._velocities]
+        # Minibatches gather rows: from a Fortran-ordered X (what many
+        # transformers return) every row would be a strided read.
+        X = np.ascontiguousarray(X)
         decays = (self.weight_decay, 0.0, 0.0, self.weight_decay)
         plan_batches = (
             balanced_batches if self.batching == "balanced" else shuffled_batches
         )
         n_lags = params.n_lags
-        history = np.empty((self.batch_size, n_lags * X.shape[1]), dtype=X.dtype)
+        # Buffers reused by every minibatch; cd_gradients accumulates
+        # ``velocity = momentum * velocity + lr / n * gradient`` in place.
+        workspace = CDWorkspace(params, self.batch_size)
         start = time.perf_counter()
         for _ in range(n_epochs):
             rng = _rng_from(self.random_state_)
             momentum = self.momentum if self.n_iter_ >= self.momentum_delay else 0.0
             squared_error = 0.0
             for batch in plan_batches(frames, self.batch_size, rng):
-                batch_history = frame_history(
-                    X, batch, n_lags, out=history[: len(batch)]
+                n = len(batch)
+                visible = np.take(
+                    X, batch, axis=0, out=workspace.visible(n), mode="clip"
                 )
-                gradients, error = cd_gradients(
-                    params, X[batch], batch_history, self.cd_steps, rng
+                batch_history = frame_history(
+                    X, batch, n_lags, out=workspace.history[:n]
+                )
+                if self.history_noise:
+                    batch_history += self.history_noise * rng.standard_normal(
+                        batch_history.shape, dtype=batch_history.dtype
+                    )
+                _, error = cd_gradients(
+                    params,
+                    visible,
+                    batch_history,
+                    self.cd_steps,
+                    rng,
+                    out=velocities,
+                    scale=self.learning_rate / n,
+                    momentum=momentum,
+                    workspace=workspace,
                 )
                 squared_error += error
-                step = self.learning_rate / len(batch)
-                for array, gradient, velocity, decay in zip(
-                    params.arrays(), gradients, velocities, decays, strict=True
+                for array, velocity, decay, scratch in zip(
+                    params.arrays(), velocities, decays, workspace.scratch, strict=True
                 ):
-                    velocity *= momentum
-                    velocity += step * gradient
                     if decay:
-                        velocity -= (self.learning_rate * decay) * array
+                        velocity -= np.multiply(
+                            array, self.learning_rate * decay, out=scratch
+                        )
                     array += velocity
             self.n_iter_ += 1
             self.reconstruction_error_ = squared_error / len(frames)
             if not params.is_finite() or not np.isfinite(squared_error):
-                self._store(params)
+                self._store(_c_ordered(params))
                 raise TrainingDivergedError(
                     f"Training diverged at epoch {self.n_iter_}: the weights became "
                     f"non-finite with learning_rate={self.learning_rate}. Lower the "
@@ -430,7 +483,7 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
                     f"reconstruction error = {self.reconstruction_error_:.4f}, "
                     f"time = {time.perf_counter() - start:.2f}s"
                 )
-        self._store(params)
+        self._store(_c_ordered(params))
 
     def _pick_seed_windows(self, X, sequences):
         """Keep up to ``_MAX_SEED_WINDOWS`` evenly spaced windows of real frames.
@@ -760,6 +813,13 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
         tags = super().__sklearn_tags__()
         tags.transformer_tags.preserves_dtype = ["float64", "float32"]
         return tags
+
+
+def _c_ordered(params):
+    """``params`` with its 2-D arrays in C order, as fitted attributes are kept."""
+    params.weights = np.ascontiguousarray(params.weights)
+    params.dynamic = np.ascontiguousarray(params.dynamic)
+    return params
 
 
 def _evenly_spaced(values, at_most):

@@ -27,10 +27,24 @@ N(c_hat + W.T h, I)``.  With binary visibles the quadratic term becomes
 """
 
 import numpy as np
-from scipy.special import expit
 
 GAUSSIAN = "gaussian"
 BINARY = "binary"
+
+
+def logistic(activation, out=None):
+    """The logistic sigmoid ``1 / (1 + exp(-a))``, elementwise, in the dtype of ``a``.
+
+    The same formula as :func:`scipy.special.expit`, built from numpy's
+    vectorised ``exp`` (several times faster than ``expit`` on the arrays of a
+    minibatch); ``out`` may be ``activation`` itself.  Very negative inputs
+    overflow ``exp`` to ``inf`` and give exactly 0, without a warning.
+    """
+    out = np.negative(activation, out=out)
+    with np.errstate(over="ignore"):
+        np.exp(out, out=out)
+    out += 1
+    return np.reciprocal(out, out=out)
 
 
 class CRBMParameters:
@@ -180,61 +194,109 @@ def _matrix_to_lag_blocks(matrix, q, n):
     return np.ascontiguousarray(np.transpose(matrix.reshape(rows, q, n), (1, 0, 2)))
 
 
-def dynamic_biases(params, history):
+def dynamic_biases(params, history, out=None):
     """Visible and hidden biases of each frame given its flattened history.
 
     Parameters
     ----------
     params : CRBMParameters
     history : ndarray of shape (n_frames, n_lags * n_features)
+    out : ndarray of shape (n_frames, n_features + n_components), default=None
+        Where to write both biases side by side (one matrix product).
 
     Returns
     -------
     visible_bias : ndarray of shape (n_frames, n_features)
     hidden_bias : ndarray of shape (n_frames, n_components)
+        Views of one array of shape ``(n_frames, n_features + n_components)``.
     """
     n = params.n_features
+    if out is None:
+        out = np.empty((history.shape[0], n + params.n_components), params.dtype)
+    # one contiguous add is several times faster than two on strided halves
+    static = np.concatenate((params.visible_bias, params.hidden_bias))
     if params.n_lags == 0:
-        shape = (history.shape[0], 1)
-        return (
-            np.broadcast_to(params.visible_bias, shape[:1] + (n,)).copy(),
-            np.broadcast_to(
-                params.hidden_bias, shape[:1] + (params.n_components,)
-            ).copy(),
-        )
-    both = history @ params.dynamic.T
-    both[:, :n] += params.visible_bias
-    both[:, n:] += params.hidden_bias
-    return both[:, :n], both[:, n:]
+        out[...] = static
+    else:
+        np.matmul(history, params.dynamic.T, out=out)
+        out += static
+    return out[:, :n], out[:, n:]
 
 
-def hidden_probabilities(params, visible, hidden_bias):
-    """p(h = 1 | v, history) (paper Eq. 2 with the dynamic hidden bias)."""
-    activation = visible @ params.weights.T
+def hidden_probabilities(params, visible, hidden_bias, out=None):
+    """p(h = 1 | v, history) (paper Eq. 2 with the dynamic hidden bias).
+
+    ``out`` (shape ``(n, n_components)``) receives the result if given.
+    """
+    activation = np.matmul(visible, params.weights.T, out=out)
     activation += hidden_bias
-    return expit(activation, out=activation)
+    return logistic(activation, out=activation)
 
 
-def visible_means(params, hidden, visible_bias):
-    """E[v | h, history] (paper Eq. 3 with the dynamic visible bias)."""
-    mean = hidden @ params.weights
+def visible_means(params, hidden, visible_bias, out=None):
+    """E[v | h, history] (paper Eq. 3 with the dynamic visible bias).
+
+    ``out`` (shape ``(n, n_features)``) receives the result if given.
+    """
+    mean = np.matmul(hidden, params.weights, out=out)
     mean += visible_bias
     if params.visible_type == BINARY:
-        expit(mean, out=mean)
+        logistic(mean, out=mean)
     return mean
 
 
-def sample_bernoulli(probabilities, rng):
-    """Binary states with the given probabilities, in their dtype."""
-    uniform = rng.random(probabilities.shape, dtype=probabilities.dtype)
-    return (uniform < probabilities).astype(probabilities.dtype)
+def sample_bernoulli(probabilities, rng, out=None):
+    """Binary states with the given probabilities, in their dtype.
+
+    One uniform draw per entry, ``state = uniform < probability``; ``out``
+    (not ``probabilities`` itself) receives the uniforms, then the states.
+    """
+    uniform = rng.random(probabilities.shape, dtype=probabilities.dtype, out=out)
+    return np.less(uniform, probabilities, out=uniform)
 
 
-def sample_visible_states(params, means, rng):
-    """Draws from p(v | h, history) given its means: N(mean, I) or Bernoulli(mean)."""
+def sample_hidden_states(
+    params, visible, hidden_bias, rng, out=None, work=None, *, negated=False
+):
+    """Binary hidden states drawn from p(h | v, history), one uniform each.
+
+    The test ``uniform < p`` with ``p = 1 / (1 + exp(-a))`` is evaluated as
+    ``uniform * (1 + exp(-a)) < 1``: the same draw (up to rounding at the
+    boundary) without the division.  ``out`` receives the states and
+    ``work`` (same shape, ``(n, n_components)``) is scratch; neither may be
+    an input.  With ``negated=True`` ``hidden_bias`` holds ``-b_hat`` (a
+    caller that uses one bias for many steps negates it once).
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        return _sample_hidden_states(
+            params, visible, hidden_bias, rng, out, work, negated
+        )
+
+
+def _sample_hidden_states(params, visible, hidden_bias, rng, out, work, negated):
+    # callers ignore overflow in exp (p = 0) and inf * 0 (p = 0 and u = 0)
+    activation = np.matmul(visible, params.weights.T, out=work)
+    if negated:
+        np.subtract(hidden_bias, activation, out=activation)
+    else:
+        activation += hidden_bias
+        np.negative(activation, out=activation)
+    uniform = rng.random(activation.shape, dtype=activation.dtype, out=out)
+    np.exp(activation, out=activation)
+    activation += 1
+    activation *= uniform
+    return np.less(activation, 1, out=uniform)
+
+
+def sample_visible_states(params, means, rng, out=None):
+    """Draws from p(v | h, history) given its means: N(mean, I) or Bernoulli(mean).
+
+    ``out`` (not ``means`` itself) receives the draws if given.
+    """
     if params.visible_type == BINARY:
-        return sample_bernoulli(means, rng)
-    return means + rng.standard_normal(means.shape, dtype=means.dtype)
+        return sample_bernoulli(means, rng, out=out)
+    noise = rng.standard_normal(means.shape, dtype=means.dtype, out=out)
+    return np.add(means, noise, out=noise)
 
 
 def free_energy(params, visible, visible_bias, hidden_bias):
@@ -253,7 +315,51 @@ def free_energy(params, visible, visible_bias, hidden_bias):
     return quadratic - softplus
 
 
-def cd_gradients(params, visible, history, cd_steps, rng):
+class CDWorkspace:
+    """Buffers that :func:`cd_gradients` reuses from one minibatch to the next.
+
+    Sized for minibatches of up to ``batch_size`` frames of one model, so
+    that a training loop allocates nothing per minibatch.  ``visible(n)`` and
+    ``history`` are where a trainer gathers a minibatch (no copy in
+    :func:`cd_gradients` then); ``scratch`` holds arrays shaped like
+    ``params.arrays()`` that are free between calls.
+    """
+
+    def __init__(self, params, batch_size):
+        n, d, h = batch_size, params.n_features, params.n_components
+        dtype = params.dtype
+        self.batch_size = batch_size
+        # [v; v_recon] and [h_data; h_recon]: the W statistics are one product
+        self.visible_stack = np.empty((2 * n, d), dtype)
+        self.hidden_stack = np.empty((2 * n, h), dtype)
+        self.hidden = np.empty((n, h), dtype)
+        self.biases = np.empty((n, d + h), dtype)
+        self.delta = np.empty((n, d + h), dtype)
+        self.history = np.empty((n, params.n_lags * d), dtype)
+        self.scratch = tuple(np.empty_like(a) for a in params.arrays())
+        self.bias_sums = np.empty(d + h, dtype)
+        self.dynamic_mask = None
+        if params.order != params.hidden_order:
+            self.dynamic_mask = np.zeros_like(params.dynamic)
+            self.dynamic_mask[...] = params.dynamic_mask()  # in the layout of dynamic
+
+    def visible(self, n):
+        """Where to gather the visible frames of a minibatch of ``n`` frames."""
+        return self.visible_stack[:n]
+
+
+def cd_gradients(
+    params,
+    visible,
+    history,
+    cd_steps,
+    rng,
+    *,
+    out=None,
+    scale=1.0,
+    momentum=0.0,
+    workspace=None,
+):
     """Contrastive-divergence statistics of one minibatch (paper Eqs. 4-7, §2.2).
 
     Positive phase: hidden probabilities from the data, binary hidden states
@@ -263,48 +369,106 @@ def cd_gradients(params, visible, history, cd_steps, rng):
     The visible bias and autoregressive gradients use the residual against
     the dynamic visible bias, which reduces to ``v - v_recon``.
 
+    The weight statistics ``h_data.T @ v - h_recon.T @ v_recon`` are one
+    matrix product of the stacked ``[h_data; h_recon]`` and ``[v; -v_recon]``;
+    those of both directed groups are one product of ``[v - v_recon, h_data -
+    h_recon]`` with the history.  ``scale`` is applied to these small
+    factors, not to the products.
+
+    Parameters
+    ----------
+    params : CRBMParameters
+    visible : ndarray of shape (n, n_features)
+    history : ndarray of shape (n, n_lags * n_features)
+    cd_steps : int
+    rng : numpy.random.Generator
+    out : tuple of ndarray, default=None
+        Arrays shaped like ``params.arrays()``.  If given, the statistics are
+        accumulated into them as ``out[k] = momentum * out[k] + scale *
+        gradient[k]`` (the momentum update of velocities); otherwise new
+        arrays hold ``scale * gradient``.
+    scale, momentum : float
+    workspace : CDWorkspace, default=None
+        Buffers for minibatches of at least ``n`` frames.
+
     Returns
     -------
     gradients : tuple of ndarray
         Sums over the batch (not means) for ``weights``, ``hidden_bias``,
         ``visible_bias`` and ``dynamic``, in the order of
-        ``CRBMParameters.arrays``; ascent directions.
+        ``CRBMParameters.arrays``; ascent directions (``out`` if given).
     squared_error : float
         Sum over the batch of ``||v - v_recon||^2``.
     """
-    visible_bias, hidden_bias = dynamic_biases(params, history)
-    positive_probabilities = hidden_probabilities(params, visible, hidden_bias)
-    positive_states = sample_bernoulli(positive_probabilities, rng)
+    n, d = visible.shape
+    if workspace is None:
+        workspace = CDWorkspace(params, n)
+    if out is None:
+        out = tuple(np.zeros_like(a) for a in params.arrays())
+        momentum = 0.0
+    stacked_visible = workspace.visible_stack[: 2 * n]
+    stacked_hidden = workspace.hidden_stack[: 2 * n]
+    data, reconstruction = stacked_visible[:n], stacked_visible[n:]
+    positive_states, negative_probabilities = stacked_hidden[:n], stacked_hidden[n:]
+    if visible.__array_interface__["data"][0] != data.__array_interface__["data"][0]:
+        np.copyto(data, visible)
+
+    visible_bias, hidden_bias = dynamic_biases(
+        params, history, out=workspace.biases[:n]
+    )
+    sample_hidden_states(
+        params,
+        data,
+        hidden_bias,
+        rng,
+        out=positive_states,
+        work=workspace.hidden[:n],
+    )
 
     hidden = positive_states
     for step in range(cd_steps):
-        reconstruction = visible_means(params, hidden, visible_bias)
-        negative_probabilities = hidden_probabilities(
-            params, reconstruction, hidden_bias
-        )
+        visible_means(params, hidden, visible_bias, out=reconstruction)
         if step + 1 < cd_steps:
-            hidden = sample_bernoulli(negative_probabilities, rng)
+            hidden = sample_hidden_states(
+                params,
+                reconstruction,
+                hidden_bias,
+                rng,
+                out=workspace.hidden[:n],
+                work=negative_probabilities,
+            )
+        else:
+            hidden_probabilities(
+                params, reconstruction, hidden_bias, out=negative_probabilities
+            )
 
-    visible_delta = visible - reconstruction
-    hidden_delta = positive_states - negative_probabilities
-    grad_weights = (
-        positive_states.T @ visible - negative_probabilities.T @ reconstruction
-    )
-    grad_hidden_bias = hidden_delta.sum(axis=0)
-    grad_visible_bias = visible_delta.sum(axis=0)
-    if params.n_lags:
-        grad_dynamic = np.concatenate((visible_delta, hidden_delta), axis=1).T @ history
-        if params.order != params.hidden_order:
-            grad_dynamic *= params.dynamic_mask()
-    else:
-        grad_dynamic = np.zeros_like(params.dynamic)
+    delta = workspace.delta[:n]
+    visible_delta = np.subtract(data, reconstruction, out=delta[:, :d])
+    np.subtract(positive_states, negative_probabilities, out=delta[:, d:])
     squared_error = float(np.einsum("ij,ij->", visible_delta, visible_delta))
-    return (
-        grad_weights,
-        grad_hidden_bias,
-        grad_visible_bias,
-        grad_dynamic,
-    ), squared_error
+
+    # the scale goes into the factors: [v; -v_recon] * scale and delta * scale
+    data *= scale
+    np.multiply(reconstruction, -scale, out=reconstruction)
+    delta *= scale
+    statistics = list(out if momentum == 0 else workspace.scratch)
+    np.matmul(stacked_hidden.T, stacked_visible, out=statistics[0])
+    bias_sums = np.sum(delta, axis=0, out=workspace.bias_sums)
+    statistics[1:3] = bias_sums[d:], bias_sums[:d]
+    if params.n_lags:
+        np.matmul(delta.T, history, out=statistics[3])
+        if workspace.dynamic_mask is not None:
+            statistics[3] *= workspace.dynamic_mask
+    else:
+        statistics[3][...] = 0
+    for velocity, statistic in zip(out, statistics, strict=True):
+        if momentum == 0:
+            if velocity is not statistic:
+                np.copyto(velocity, statistic)
+        else:
+            velocity *= momentum
+            velocity += statistic
+    return out, squared_error
 
 
 def gibbs_frames(
@@ -342,29 +506,38 @@ def gibbs_frames(
     -------
     frames : ndarray of shape (n, n_features)
     """
+    # every step works in these buffers: no allocation inside the loop
     visible = start.copy()
-    clamped = None
-    if observed_mask is not None:
-        clamped = start[observed_mask]
-    for _ in range(n_gibbs):
-        bias = hidden_bias
-        if hidden_noise:
-            bias = hidden_bias + hidden_noise * rng.standard_normal(
-                hidden_bias.shape, dtype=hidden_bias.dtype
-            )
-        hidden = sample_bernoulli(hidden_probabilities(params, visible, bias), rng)
-        visible = visible_means(params, hidden, visible_bias)
-        if sample_visibles:
-            visible = sample_visible_states(params, visible, rng)
-        if clamped is not None:
-            visible[observed_mask] = clamped
+    visible_bias = np.ascontiguousarray(visible_bias)
+    negative_bias = np.negative(hidden_bias)  # -b_hat, contiguous, once
+    hidden = np.empty_like(negative_bias)
+    work = np.empty_like(negative_bias)
+    noisy_bias = np.empty_like(negative_bias) if hidden_noise else None
+    drawn = np.empty_like(visible) if sample_visibles else None
+    with np.errstate(over="ignore", invalid="ignore"):
+        for _ in range(n_gibbs):
+            bias = negative_bias
+            if hidden_noise:  # -(b_hat + noise * z), the draws as before
+                bias = rng.standard_normal(
+                    hidden.shape, dtype=hidden.dtype, out=noisy_bias
+                )
+                bias *= -hidden_noise
+                bias += negative_bias
+            _sample_hidden_states(params, visible, bias, rng, hidden, work, True)
+            visible_means(params, hidden, visible_bias, out=visible)
+            if sample_visibles:
+                visible, drawn = (
+                    sample_visible_states(params, visible, rng, out=drawn),
+                    visible,
+                )
+            if observed_mask is not None:
+                np.copyto(visible, start, where=observed_mask)
     if sample_visibles:
         return visible
-    visible = visible_means(
-        params, hidden_probabilities(params, visible, hidden_bias), visible_bias
-    )
-    if clamped is not None:
-        visible[observed_mask] = clamped
+    hidden_probabilities(params, visible, hidden_bias, out=hidden)
+    visible_means(params, hidden, visible_bias, out=visible)
+    if observed_mask is not None:
+        np.copyto(visible, start, where=observed_mask)
     return visible
 
 
@@ -377,9 +550,114 @@ def mean_field_prediction(params, visible_bias, hidden_bias, n_steps):
     """
     visible = visible_bias.copy()
     if params.visible_type == BINARY:
-        expit(visible, out=visible)
+        logistic(visible, out=visible)
     for _ in range(n_steps):
         visible = visible_means(
             params, hidden_probabilities(params, visible, hidden_bias), visible_bias
         )
     return visible
+
+
+def stacked_gibbs_frames(
+    layers, start, visible_biases, hidden_biases, n_gibbs, rng, *, observed_mask=None
+):
+    """Alternating Gibbs sampling of new frames through a stack of CRBMs.
+
+    With one layer this is :func:`gibbs_frames`.  With more, each iteration
+    passes the frame up the lower layers (hidden probabilities, as the
+    layers above were trained on), takes one alternating step of the top
+    layer (its hidden units sampled, its visibles set to their mean), and
+    passes the result down the lower layers as visible means (the
+    generation scheme of the original two-level code, ``gen2.m``).  Where
+    ``observed_mask`` is True the frame stays clamped at ``start``.  The last
+    iteration is mean field.
+
+    Parameters
+    ----------
+    layers : list of CRBMParameters
+        Bottom layer first; layer ``l + 1``'s visibles are layer ``l``'s
+        hidden units.
+    start : ndarray of shape (n, n_features)
+    visible_biases, hidden_biases : list of ndarray
+        Every layer's dynamic biases (:func:`dynamic_biases` with that
+        layer's own history).
+
+    Returns
+    -------
+    frames : ndarray of shape (n, n_features)
+    """
+    if len(layers) == 1:
+        return gibbs_frames(
+            layers[0],
+            start,
+            visible_biases[0],
+            hidden_biases[0],
+            n_gibbs,
+            rng,
+            observed_mask=observed_mask,
+        )
+    visible = start.copy()
+    clamped = None if observed_mask is None else start[observed_mask]
+    top = layers[-1]
+    for step in range(n_gibbs + 1):
+        state = visible
+        for params, hidden_bias in zip(layers[:-1], hidden_biases[:-1], strict=True):
+            state = hidden_probabilities(params, state, hidden_bias)
+        hidden = hidden_probabilities(top, state, hidden_biases[-1])
+        if step < n_gibbs:
+            hidden = sample_bernoulli(hidden, rng)
+        state = visible_means(top, hidden, visible_biases[-1])
+        below = zip(layers[-2::-1], visible_biases[-2::-1], strict=True)
+        for params, visible_bias in below:
+            state = visible_means(params, state, visible_bias)
+        visible = state
+        if clamped is not None:
+            visible[observed_mask] = clamped
+    return visible
+
+
+def stacked_prediction(layers, visible_biases, hidden_biases, n_steps):
+    """One-step prediction of a frame through a stack, from the histories alone.
+
+    The top layer's :func:`mean_field_prediction`, passed down the lower
+    layers as visible means.
+    """
+    predicted = mean_field_prediction(
+        layers[-1], visible_biases[-1], hidden_biases[-1], n_steps
+    )
+    below = zip(layers[-2::-1], visible_biases[-2::-1], strict=True)
+    for params, visible_bias in below:
+        predicted = visible_means(params, predicted, visible_bias)
+    return predicted
+
+
+def observed_log_likelihood(params, prediction, visible, observed_mask):
+    """Log-likelihood of a frame's observed channels under a one-step prediction.
+
+    Approximates ``log p(v_o | history)``, up to a constant shared by all
+    rows, by the likelihood of ``v_o`` given the model's prediction of the
+    frame from its history (:func:`mean_field_prediction` or
+    :func:`stacked_prediction`): Gaussian with the model's unit variance
+    around it, or Bernoulli with it as probabilities.  Particles of an
+    on-line filter are weighted by it.
+
+    Parameters
+    ----------
+    params : CRBMParameters
+        The bottom layer (its visible type).
+    prediction : ndarray of shape (n, n_features)
+    visible : ndarray of shape (n, n_features)
+        Frames; only the entries where ``observed_mask`` is True are read.
+    observed_mask : ndarray of bool of shape (n, n_features)
+
+    Returns
+    -------
+    log_likelihood : ndarray of shape (n,)
+    """
+    if params.visible_type == BINARY:
+        eps = np.finfo(prediction.dtype).eps
+        prediction = np.clip(prediction, eps, 1 - eps)
+        terms = np.where(visible > 0.5, np.log(prediction), np.log1p(-prediction))
+        return np.where(observed_mask, terms, 0).sum(axis=1)
+    residual = np.where(observed_mask, visible - prediction, 0)
+    return -0.5 * np.einsum("ij,ij->i", residual, residual)

@@ -12,6 +12,7 @@
 from ._acclaim import read_amc, write_amc
 from ._base import get_data_home, load_cmu35, load_mit_walk
 from ._bvh import read_bvh, write_bvh
+from ._channels import bone_columns
 from ._fetch import fetch_cmu35, fetch_mit_walk
 from ._generators import make_oscillations, make_walker
 from ._skeleton import Bone, Skeleton
@@ -19,6 +20,7 @@ from ._skeleton import Bone, Skeleton
 __all__ = [
     "Bone",
     "Skeleton",
+    "bone_columns",
     "fetch_cmu35",
     "fetch_mit_walk",
     "get_data_home",

@@ -1,5 +1,6 @@
 """Acclaim ASF (skeleton) and AMC (motion) files, as written by the CMU database."""
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -10,6 +11,8 @@ from ._skeleton import (
     TRANSLATION_CHANNELS,
     Bone,
     Skeleton,
+    _as_frames,
+    _norm,
     column_indices,
 )
 
@@ -208,7 +211,7 @@ class _AsfParser:
         order = root["axis"] or "xyz"
         rotation_order = "".join(a for a in order if a in euler_axes)
         position = np.asarray(root["position"], dtype=np.float64)
-        length = float(np.linalg.norm(position))
+        length = _norm(position)
         return Bone(
             name="root",
             parent=None,
@@ -310,7 +313,10 @@ def read_amc(path, skeleton):
     ValueError
         If the file is malformed: a bad number, a bone the skeleton does not
         have, a bone with the wrong number of values, a frame that lacks
-        bones (e.g. a truncated file).  The message names the file and line.
+        bones (e.g. a truncated file), no frame at all (an empty file).  The
+        message names the file and line.
+    TypeError
+        If ``skeleton`` is neither a Skeleton nor a path.
 
     Examples
     --------
@@ -319,11 +325,10 @@ def read_amc(path, skeleton):
     >>> data.shape  # doctest: +SKIP
     (358, 62)
     """
-    if not isinstance(skeleton, Skeleton):
-        skeleton = Skeleton.from_asf(skeleton)
+    skeleton = _check_skeleton(skeleton, "read_amc", allow_path=True)
     layout = _amc_layout(skeleton)
     n_features = len(skeleton.feature_names)
-    frames, frame = [], None
+    frames, frame, lineno = [], None, 1
     for lineno, text in _content_lines(path):
         tokens = text.split()
         if tokens[0].startswith(":"):
@@ -331,6 +336,7 @@ def read_amc(path, skeleton):
                 raise parse_error(
                     path, lineno, f"header line {text!r} after the first frame"
                 )
+            _check_amc_unit(path, lineno, tokens[0], skeleton)
             continue
         if len(tokens) == 1 and tokens[0].lstrip("-").isdigit():
             if frame is not None:
@@ -342,8 +348,44 @@ def read_amc(path, skeleton):
         _amc_bone_line(path, lineno, tokens, frame, layout)
     if frame is not None:
         frames.append(_finish_frame(path, frame, layout))
+    if not frames:
+        raise parse_error(
+            path,
+            lineno,
+            "no frames: an AMC file holds a frame number, then one line per bone "
+            "(empty or truncated file?)",
+        )
     data = np.array(frames, dtype=np.float64).reshape(len(frames), n_features)
     return data, skeleton.feature_names
+
+
+_AMC_UNITS = {":degrees": "deg", ":radians": "rad"}
+
+
+def _check_amc_unit(path, lineno, keyword, skeleton):
+    """An AMC ``:DEGREES`` or ``:RADIANS`` header must agree with the skeleton."""
+    unit = _AMC_UNITS.get(keyword.lower())
+    if unit is not None and unit != skeleton.angle_unit:
+        raise parse_error(
+            path,
+            lineno,
+            f"the file's angles are in {keyword[1:].lower()} but the skeleton's "
+            f"(angle_unit={skeleton.angle_unit!r}) are not; read it with the "
+            "skeleton of its own ASF file",
+        )
+
+
+def _check_skeleton(skeleton, function, allow_path=False):
+    """The skeleton itself, read from an ASF path if allowed, or a TypeError."""
+    if isinstance(skeleton, Skeleton):
+        return skeleton
+    if allow_path and isinstance(skeleton, (str, os.PathLike)):
+        return Skeleton.from_asf(skeleton)
+    what = "a Skeleton or the path of an ASF file" if allow_path else "a Skeleton"
+    raise TypeError(
+        f"{function} needs {what}, got {type(skeleton).__name__} {skeleton!r}; "
+        "read one with sklearn_crbm.datasets.Skeleton.from_asf(path)."
+    )
 
 
 def _amc_layout(skeleton):
@@ -422,6 +464,7 @@ def write_amc(path, data, skeleton, feature_names=None):
     >>> np.array_equal(data, walker.data)
     True
     """
+    skeleton = _check_skeleton(skeleton, "write_amc")
     X = _ordered_channels(data, skeleton, feature_names)
     unit = ":DEGREES" if skeleton.angle_unit == "deg" else ":RADIANS"
     lines = [
@@ -441,7 +484,7 @@ def write_amc(path, data, skeleton, feature_names=None):
 
 def _ordered_channels(data, skeleton, feature_names):
     """``data`` as floats with its columns in ``skeleton.feature_names`` order."""
-    X = np.asarray(data, dtype=np.float64)
+    X = _as_frames(data)
     if X.ndim != 2:
         raise ValueError(
             f"data must be 2-D (n_frames, n_features), got shape {X.shape}."
@@ -450,6 +493,10 @@ def _ordered_channels(data, skeleton, feature_names):
     wanted = list(skeleton.feature_names)
     columns = column_indices(names, wanted, n_columns=X.shape[1])
     X = X[:, [columns[name] for name in wanted]]
+    if X.shape[0] == 0:
+        raise ValueError(
+            f"data has no frames; an AMC file needs at least one (shape {X.shape})."
+        )
     if not np.all(np.isfinite(X)):
         raise ValueError(
             "data contain NaN or infinite values; fill them before writing."

@@ -4,10 +4,10 @@ import os
 from pathlib import Path
 
 import numpy as np
-import scipy.io
 from sklearn.utils import Bunch
 
 from ._mit import load_mit_mat, read_mit_skeleton
+from ._parsing import load_mat_variables
 from ._skeleton import Skeleton
 
 __all__ = ["get_data_home", "load_cmu35", "load_mit_walk"]
@@ -157,7 +157,9 @@ def load_cmu35(data_home=None, *, subset="all"):
     mat_path = _data_file(data_home, CMU35_FOLDER, "cmu35WalkJog.mat", "fetch_cmu35")
     asf_path = _data_file(data_home, CMU35_FOLDER, "35.asf", "fetch_cmu35")
     skeleton = Skeleton.from_asf(asf_path)
-    mat = scipy.io.loadmat(mat_path)
+    mat = load_mat_variables(
+        mat_path, ("Y", "lbls", "Ytest", "lblstest"), "fetch_cmu35"
+    )
     parts = []
     if subset in ("all", "train"):
         parts.append((mat["Y"], mat["lbls"], CMU35_TRAIN))

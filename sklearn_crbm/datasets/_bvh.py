@@ -1,5 +1,6 @@
 """Biovision BVH files: a skeleton header (HIERARCHY) and motion (MOTION)."""
 
+import numbers
 from pathlib import Path
 
 import numpy as np
@@ -65,7 +66,12 @@ def _parse_hierarchy(tokens):
         )
     tokens.expect("ROOT")
     bones = []
-    _parse_joint(tokens, None, bones, set())
+    try:
+        _parse_joint(tokens, None, bones, set())
+    except RecursionError:
+        raise tokens.error(
+            "joints are nested too deeply (or a '}' is missing)", lineno
+        ) from None
     if tokens.pos < len(tokens.items):
         lineno, token = tokens.items[tokens.pos]
         raise tokens.error(
@@ -99,19 +105,30 @@ def _parse_joint(tokens, parent, bones, names):
             end = np.array(tokens.floats(3, "OFFSET value"))
             tokens.expect("}")
             names.add(name + END_SITE_SUFFIX)
-            bones.append(_bvh_bone(name + END_SITE_SUFFIX, name, end, ()))
+            bones.append(
+                _checked_bone(tokens, lineno, name + END_SITE_SUFFIX, name, end, ())
+            )
         elif key == "}":
             break
         else:
             raise tokens.error(f"unexpected {word!r} in joint {name!r}", lineno)
     if offset is None:
         raise tokens.error(f"joint {name!r} has no OFFSET", lineno)
-    bones[index] = _bvh_bone(name, parent, offset, channels)
+    bones[index] = _checked_bone(tokens, lineno, name, parent, offset, channels)
+
+
+def _checked_bone(tokens, lineno, *args):
+    """:func:`_bvh_bone`, its ValueError (a repeated channel, a huge offset)
+    turned into one that names the file and line."""
+    try:
+        return _bvh_bone(*args)
+    except ValueError as exc:
+        raise tokens.error(str(exc), lineno) from None
 
 
 def _parse_channels(tokens):
     lineno, count = tokens.next("the number of channels")
-    if not count.isdigit():
+    if not (count.isascii() and count.isdigit()):
         raise tokens.error(f"bad number of channels {count!r}", lineno)
     channels = []
     for _ in range(int(count)):
@@ -126,7 +143,8 @@ def _parse_channels(tokens):
 
 
 def _bvh_bone(name, parent, offset, channels):
-    length = float(np.linalg.norm(offset))
+    with np.errstate(over="ignore"):
+        length = float(np.hypot(np.hypot(offset[0], offset[1]), offset[2]))
     rotation_axes = [c[1] for c in channels if c in EULER_CHANNELS]
     return Bone(
         name=name,
@@ -220,7 +238,7 @@ def _parse_motion_header(path, motion):
             path, lines[0][0], f"expected a whole number of frames, got {n_frames!r}"
         )
     frame_time = _labelled_number(path, lines, 1, "Frame Time:", end_line)
-    if not frame_time > 0:
+    if not (frame_time > 0 and np.isfinite(1.0 / frame_time)):
         raise parse_error(
             path, lines[1][0], f"expected a positive frame time, got {frame_time!r}"
         )
@@ -311,8 +329,21 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
     >>> path = os.path.join(tempfile.mkdtemp(), "walk.bvh")
     >>> write_bvh(path, walker.data, walker.skeleton, frame_rate=30.0)
     """
-    if not frame_rate > 0:
-        raise ValueError(f"frame_rate must be positive, got {frame_rate!r}.")
+    if not isinstance(skeleton, Skeleton):
+        raise TypeError(
+            f"write_bvh needs a Skeleton, got {type(skeleton).__name__} "
+            f"{skeleton!r}; read one with sklearn_crbm.datasets.Skeleton.from_asf "
+            "or Skeleton.from_bvh."
+        )
+    if (
+        isinstance(frame_rate, bool)
+        or not isinstance(frame_rate, numbers.Real)
+        or not (0 < frame_rate < np.inf)
+    ):
+        raise ValueError(
+            "frame_rate must be positive, a number of frames per second such as "
+            f"30.0, got {frame_rate!r}."
+        )
     roots = [bone.name for bone in skeleton.bones if bone.parent is None]
     if len(roots) > 1:
         raise ValueError(f"A BVH file has one ROOT; the skeleton has roots {roots}.")
@@ -326,13 +357,19 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
     local = skeleton.local_rotations(
         X, skeleton.feature_names if feature_names is None else feature_names
     )
-    joints = _bvh_joints(skeleton)
+    try:
+        joints = _bvh_joints(skeleton)
+        lines = ["HIERARCHY"]
+        _hierarchy_lines(skeleton, joints, skeleton.bones[0].name, 0, lines)
+    except RecursionError:
+        raise ValueError(
+            f"The skeleton nests {len(skeleton.bones)} bones too deeply to be "
+            "written as a BVH file."
+        ) from None
     values = np.column_stack(
         [_joint_values(skeleton, joint, X, columns, local) for joint in joints.values()]
         or [np.empty((X.shape[0], 0))]
     )
-    lines = ["HIERARCHY"]
-    _hierarchy_lines(skeleton, joints, skeleton.bones[0].name, 0, lines)
     lines += [
         "MOTION",
         f"Frames: {X.shape[0]}",

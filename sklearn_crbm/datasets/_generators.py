@@ -61,7 +61,7 @@ def make_oscillations(
     n_sequences = _check_count(n_sequences, "n_sequences")
     n_frames = _check_count(n_frames, "n_frames")
     n_features = _check_count(n_features, "n_features")
-    if not isinstance(noise, numbers.Real) or noise < 0:
+    if not isinstance(noise, numbers.Real) or not 0 <= noise < np.inf:
         raise ValueError(f"noise must be a non-negative number, got {noise!r}.")
     rng = check_random_state(random_state)
     lags = 2.0 * np.pi * np.arange(n_features) / n_features

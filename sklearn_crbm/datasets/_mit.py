@@ -32,8 +32,8 @@ node  bone name    what it is
 import os
 
 import numpy as np
-import scipy.io
 
+from ._parsing import load_mat_variables
 from ._skeleton import (
     EXPMAP_CHANNELS,
     OFFSET_CHANNELS,
@@ -70,7 +70,7 @@ def _indices(value):
 
 def load_mit_mat(path):
     """``(skel, motions)`` from one of Taylor's MIT ``.mat`` files."""
-    mat = scipy.io.loadmat(os.fspath(path))
+    mat = load_mat_variables(path, ("skel", "Motion"), "fetch_mit_walk")
     return mat["skel"], [np.asarray(m, dtype=np.float64) for m in mat["Motion"].flat]
 
 
@@ -80,7 +80,14 @@ def read_mit_skeleton(skel, offsets=None):
         skel, motions = load_mit_mat(skel)
         if offsets is None:
             offsets = motions[0][0]
-    kind = str(np.asarray(_field(skel, "type")).ravel()[0])
+    try:
+        kind = str(np.asarray(_field(skel, "type")).ravel()[0])
+    except (AttributeError, IndexError, KeyError, TypeError, ValueError):
+        raise TypeError(
+            "skel must be the 'skel' struct of Taylor's MIT data as loaded by "
+            "scipy.io.loadmat, or the path of its .mat file; got "
+            f"{type(skel).__name__}."
+        ) from None
     if kind != "mit":
         raise ValueError(f"Expected a skel of type 'mit', got type {kind!r}.")
     nodes = list(np.asarray(_field(skel, "tree")).flat)
@@ -88,6 +95,11 @@ def read_mit_skeleton(skel, offsets=None):
         raise ValueError(f"Expected an MIT skel with 18 nodes, got {len(nodes)}.")
     if offsets is not None:
         offsets = np.asarray(offsets, dtype=np.float64).ravel()
+        if offsets.shape != (6 * len(nodes),) or not np.all(np.isfinite(offsets)):
+            raise ValueError(
+                f"offsets must be one frame of MIT data: {6 * len(nodes)} finite "
+                f"values, got shape {offsets.shape}."
+            )
     bones, column = [], 0
     for k, node in enumerate(nodes):
         rotation, offset_cols = (

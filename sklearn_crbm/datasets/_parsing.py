@@ -1,8 +1,15 @@
 """Helpers shared by the text-format readers: errors that name file and line."""
 
+import math
 import os
 
-__all__ = ["format_number", "parse_error", "parse_floats", "read_lines"]
+__all__ = [
+    "format_number",
+    "load_mat_variables",
+    "parse_error",
+    "parse_floats",
+    "read_lines",
+]
 
 
 def parse_error(path, lineno, message):
@@ -16,21 +23,43 @@ def read_lines(path):
     Returns
     -------
     lines : list of (int, str)
+
+    Raises
+    ------
+    TypeError
+        If ``path`` is not a str, bytes or path-like object.
+    OSError
+        If the file cannot be read (e.g. it does not exist).
     """
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(
+            f"Expected the path of a file (str or os.PathLike), got "
+            f"{type(path).__name__} {path!r}."
+        )
     with open(path, encoding="utf-8", errors="replace") as f:
         return [(i, line.rstrip("\r\n")) for i, line in enumerate(f, start=1)]
 
 
 def parse_floats(tokens, path, lineno, what="value"):
-    """Convert tokens to floats, raising :func:`parse_error` on a bad number."""
+    """Convert tokens to floats, raising :func:`parse_error` on a bad number.
+
+    NaN and infinity (``nan``, ``inf``, ``1e999``) are bad numbers too: no
+    motion-capture file holds them, and they would poison everything
+    computed from the data.
+    """
     values = []
     for token in tokens:
         try:
-            values.append(float(token))
+            value = float(token)
         except ValueError:
             raise parse_error(
                 path, lineno, f"bad {what} {token!r}, expected a number"
             ) from None
+        if not math.isfinite(value):
+            raise parse_error(
+                path, lineno, f"bad {what} {token!r}, expected a finite number"
+            )
+        values.append(value)
     return values
 
 
@@ -40,3 +69,33 @@ def format_number(value):
     if value.is_integer() and abs(value) < 1e15:
         return str(int(value))
     return repr(value)
+
+
+def load_mat_variables(path, names, fetcher):
+    """The variables ``names`` of a MATLAB file, or a ValueError if it is damaged.
+
+    ``fetcher`` names the function that downloads the file again; the error
+    message points the user at it.  A file that cannot be opened at all
+    (missing, no permission) keeps its ``OSError``.
+    """
+    import scipy.io
+    from scipy.io.matlab import MatReadError
+
+    path = os.fspath(path)
+    hint = f"Fetch it again with sklearn_crbm.datasets.{fetcher}()."
+    try:
+        mat = scipy.io.loadmat(path)
+    except (FileNotFoundError, PermissionError, IsADirectoryError):
+        raise
+    except (MatReadError, OSError, ValueError, TypeError, KeyError) as exc:
+        raise ValueError(
+            f"{path} is not a readable MATLAB file ({exc}); it may be truncated or "
+            f"damaged. {hint}"
+        ) from exc
+    missing = [name for name in names if name not in mat]
+    if missing:
+        raise ValueError(
+            f"{path} lacks the variables {missing}; it is not the expected data "
+            f"file. {hint}"
+        )
+    return mat

@@ -86,14 +86,30 @@ class Bone:
     axis_order: str = "xyz"
 
     def __post_init__(self):
-        direction = np.asarray(self.direction, dtype=np.float64).reshape(3)
-        norm = np.linalg.norm(direction)
+        direction = _vector3(self.direction, self.name, "direction")
+        norm = _norm(direction)
         self.direction = direction / norm if norm > 0 else direction
-        self.length = float(self.length)
+        length = _finite_number(self.length, self.name, "length")
+        if length < 0:
+            raise ValueError(
+                f"Bone {self.name!r}: length must be >= 0, got {length!r}; give the "
+                "direction the sign instead."
+            )
+        self.length = length
+        if isinstance(self.channels, str):
+            raise TypeError(
+                f"Bone {self.name!r}: channels must be a sequence of channel names "
+                f"such as ('rx', 'ry', 'rz'), got the string {self.channels!r}."
+            )
         self.channels = tuple(str(c) for c in self.channels)
         self.rotation_order = str(self.rotation_order).lower()
-        self.axis = np.asarray(self.axis, dtype=np.float64).reshape(3)
+        self.axis = _vector3(self.axis, self.name, "axis")
         self.axis_order = str(self.axis_order).lower()
+        if sorted(self.axis_order) != ["x", "y", "z"]:
+            raise ValueError(
+                f"Bone {self.name!r}: axis_order must hold each of 'x', 'y', 'z' "
+                f"once (e.g. 'xyz'), got {self.axis_order!r}."
+            )
         _check_bone_channels(self)
 
     @property
@@ -109,6 +125,43 @@ class Bone:
         if any(c in EXPMAP_CHANNELS for c in self.channels):
             return "expmap"
         return ""
+
+
+def _vector3(value, name, what):
+    """Three finite floats, or a ValueError naming the bone and the field."""
+    try:
+        vector = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"Bone {name!r}: {what} must be three numbers, got {value!r}."
+        ) from None
+    if vector.size != 3:
+        raise ValueError(
+            f"Bone {name!r}: {what} must be three numbers, got shape {vector.shape}."
+        )
+    if not np.all(np.isfinite(vector)):
+        raise ValueError(f"Bone {name!r}: {what} must be finite, got {vector}.")
+    return vector.reshape(3)
+
+
+def _finite_number(value, name, what):
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"Bone {name!r}: {what} must be a number, got {value!r}."
+        ) from None
+    if not np.isfinite(number):
+        raise ValueError(f"Bone {name!r}: {what} must be finite, got {number!r}.")
+    return number
+
+
+def _norm(vector):
+    """Euclidean norm without overflow for huge components (e.g. 1e300)."""
+    scale = np.max(np.abs(vector))
+    if scale == 0:
+        return 0.0
+    return float(scale * np.linalg.norm(vector / scale))
 
 
 def _check_bone_channels(bone):
@@ -187,6 +240,12 @@ class Skeleton:
     ):
         self.name = str(name)
         self.bones = list(bones)
+        not_bones = [b for b in self.bones if not isinstance(b, Bone)]
+        if not_bones:
+            raise TypeError(
+                f"A skeleton is built from Bone objects, got {not_bones[0]!r} "
+                f"({type(not_bones[0]).__name__}); see sklearn_crbm.datasets.Bone."
+            )
         self.up_axis = str(up_axis).lower()
         self.angle_unit = str(angle_unit).lower()
         self.length_scale = float(length_scale)
@@ -264,6 +323,19 @@ class Skeleton:
         """Names of the bones whose parent is ``name``."""
         self.bone(name)
         return [bone.name for bone in self.bones if bone.parent == name]
+
+    def descendants(self, name):
+        """``name`` and every bone below it, parents before children.
+
+        For instance ``skeleton.descendants("lowerback")`` is the whole upper
+        body of a CMU skeleton, and ``descendants("lfemur")`` the left leg.
+        """
+        self.bone(name)
+        found = [name]
+        for bone in self.bones:
+            if bone.parent in found:
+                found.append(bone.name)
+        return found
 
     @property
     def feature_names(self):
@@ -356,7 +428,7 @@ class Skeleton:
         ]
 
     def _columns(self, data, feature_names):
-        X = np.asarray(data, dtype=np.float64)
+        X = _as_frames(data)
         if X.ndim != 2:
             raise ValueError(
                 f"data must be 2-D (n_frames, n_features), got shape {X.shape}."
@@ -448,6 +520,24 @@ class Skeleton:
         from ._mit import read_mit_skeleton
 
         return read_mit_skeleton(skel, offsets)
+
+
+def _as_frames(data):
+    """``data`` as a float64 array, or a clear error for sparse or non-numeric data.
+
+    The shape is checked by the caller.
+    """
+    if hasattr(data, "toarray") or hasattr(data, "tocsr"):
+        raise TypeError(
+            "data must be a dense array of raw channels, got a sparse matrix; "
+            "convert it with .toarray()."
+        )
+    try:
+        return np.asarray(data, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(
+            f"data must be a numeric array of shape (n_frames, n_features): {exc}"
+        ) from None
 
 
 def column_indices(feature_names, required, *, n_columns=None):

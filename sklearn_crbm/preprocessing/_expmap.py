@@ -310,6 +310,10 @@ class ExpMapEncoder(TransformerMixin, BaseEstimator):
         names_out[self._passthrough[:, 0]] = names_in[self._passthrough[:, 1]]
         return names_out
 
+    def __sklearn_is_fitted__(self):
+        # set last by fit: a fit that failed half-way leaves the encoder unfitted
+        return hasattr(self, "encoded_bones_")
+
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
         tags.input_tags.allow_nan = True

@@ -40,8 +40,20 @@ class EulerBlock:
         return min(self.columns)
 
 
+def check_skeleton(skeleton):
+    """The skeleton, or a TypeError when it is not one (a path, a list...)."""
+    if not hasattr(skeleton, "bones"):
+        raise TypeError(
+            "skeleton must be a sklearn_crbm.datasets.Skeleton (e.g. "
+            "Skeleton.from_asf(path) or load_cmu35().skeleton) or None, got "
+            f"{type(skeleton).__name__} {skeleton!r}."
+        )
+    return skeleton
+
+
 def _skeleton_rotation_orders(skeleton):
     """Map feature name -> (bone, channel) and bone -> Euler axes, from a skeleton."""
+    check_skeleton(skeleton)
     channel_of = {}
     orders = {}
     for bone in skeleton.bones:
@@ -63,6 +75,7 @@ def _skeleton_rotation_orders(skeleton):
 
 def skeleton_feature_names(skeleton):
     """The raw feature names of a skeleton, ``"{bone}_{channel}"`` in order."""
+    check_skeleton(skeleton)
     names = getattr(skeleton, "feature_names", None)
     if names is None:
         names = [f"{b.name}_{ch}" for b in skeleton.bones for ch in b.channels]

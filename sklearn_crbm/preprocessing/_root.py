@@ -390,6 +390,10 @@ class RootRelativeEncoder(TransformerMixin, BaseEstimator):
         out[self._root_out] = [f"{self.root}_{c}" for c in _ROOT_OUT]
         return out
 
+    def __sklearn_is_fitted__(self):
+        # set last by fit: a fit that failed half-way leaves the encoder unfitted
+        return hasattr(self, "_root_out")
+
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
         tags.input_tags.allow_nan = True

@@ -33,6 +33,11 @@ _AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 # Below this value of cos(middle angle) a three-axis decomposition is taken to
 # be in gimbal lock and its last angle is set to zero.
 _GIMBAL_TOL = 4 * np.finfo(np.float64).eps
+# Below this value of sin(theta) * (n . axis) a rotation by theta ~ pi is
+# taken to be exactly pi, where n and -n are the same rotation.
+_PI_TIE_TOL = 1e-12
+# Components of a unit rotation axis smaller than this are rounding noise.
+_AXIS_ZERO_TOL = 1e-9
 
 
 def _check_axes(axes, k=None):
@@ -254,7 +259,8 @@ def matrix_to_expmap(R):
     r : ndarray of shape (..., 3)
         ``theta * n`` with ``0 <= theta <= pi``.  At exactly ``theta = pi``,
         where ``n`` and ``-n`` give the same rotation, the sign is chosen so
-        that the largest component of ``n`` is positive.
+        that the first non-zero component of ``n`` is positive (so +180 and
+        -180 degrees about an axis give the same map).
 
     Notes
     -----
@@ -306,7 +312,13 @@ def matrix_to_expmap(R):
     norm = np.linalg.norm(n, axis=-1, keepdims=True)
     n = n / np.where(norm > 0, norm, 1.0)
     along = np.sum(n * w, axis=-1)
-    flip = along < 0
+    # At theta = pi, w is rounding noise whose sign follows that of the input
+    # (sin(+-pi) = +-1.2e-16), and so is the pivot when two components of n
+    # are equally large: use the tie-break of the docstring there, so that
+    # +180 and -180 degrees give the same map.
+    first = np.argmax(np.abs(n) > _AXIS_ZERO_TOL, axis=-1)
+    negative_first = np.take_along_axis(n, first[..., None], axis=-1)[..., 0] < 0
+    flip = np.where(np.abs(along) > _PI_TIE_TOL, along < 0, negative_first)
     n = np.where(flip[..., None], -n, n)
     r_large = n * theta[..., None]
 

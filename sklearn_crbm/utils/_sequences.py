@@ -8,6 +8,7 @@ estimator ever materialises the history of the whole data set.
 """
 
 from dataclasses import dataclass
+from numbers import Integral
 
 import numpy as np
 
@@ -161,10 +162,20 @@ def _as_integer_ids(ids):
                 "sequence_ids must be integers, got non-integral floats; give "
                 "every frame an integer sequence id."
             )
+        if np.any(np.abs(ids) >= 2.0**63):
+            raise ValueError(
+                "sequence_ids holds ids beyond the 64-bit integer range; number "
+                "the sequences 0, 1, 2, ..."
+            )
         return ids.astype(np.int64)
     if kind == "O":
         try:
             as_int = ids.astype(np.int64)
+        except OverflowError:
+            raise ValueError(
+                "sequence_ids holds ids beyond the 64-bit integer range; number "
+                "the sequences 0, 1, 2, ..."
+            ) from None
         except (TypeError, ValueError) as exc:
             raise TypeError(
                 "sequence_ids must be integers; got objects that are not. Map "
@@ -219,8 +230,16 @@ def frame_history(X, frames, n_lags, frame_starts=None, out=None):
     n_features = X.shape[1]
     if out is None:
         return X[indices.ravel()].reshape(len(indices), n_lags * n_features)
-    np.take(X, indices.ravel(), axis=0, out=out.reshape(-1, n_features))
+    # mode="clip": with mode="raise" numpy buffers ``out`` (several times slower)
+    np.take(X, indices.ravel(), axis=0, out=out.reshape(-1, n_features), mode="clip")
     return out
+
+
+def _check_batch_size(batch_size):
+    if isinstance(batch_size, bool) or not isinstance(batch_size, Integral):
+        raise TypeError(f"batch_size must be an integer, got {batch_size!r}.")
+    if batch_size < 1:
+        raise ValueError(f"batch_size must be at least 1, got {batch_size!r}.")
 
 
 def shuffled_batches(frames, batch_size, rng):
@@ -228,6 +247,7 @@ def shuffled_batches(frames, batch_size, rng):
 
     Returns a list of index arrays; only the last batch may be smaller.
     """
+    _check_batch_size(batch_size)
     order = rng.permutation(frames)
     return [order[i : i + batch_size] for i in range(0, len(order), batch_size)]
 
@@ -241,6 +261,7 @@ def balanced_batches(frames, batch_size, rng):
     data set (every sequence, every style) and holds no two neighbouring
     frames, which keeps the frames of a batch as uncorrelated as possible.
     """
+    _check_batch_size(batch_size)
     n_frames = len(frames)
     if n_frames == 0:
         return []

@@ -1,0 +1,118 @@
+"""Memory that ConditionalRBM.fit adds on top of its data, whatever the order.
+
+For each order (``--orders``), a fresh Python process builds ``--frames``
+(default 1,000,000) synthetic standardised frames of 62 dimensions in
+float32 (sequences of 100 frames), then fits a 200-hidden-unit CRBM for one
+epoch and reports:
+
+- ``traced MB``: the peak of memory allocated during ``fit`` (tracemalloc,
+  which sees numpy's buffers) above what was allocated before it;
+- ``peak RSS MB``: the growth of the process's peak resident memory during
+  ``fit`` (``VmHWM`` after resetting it through ``/proc/self/clear_refs``,
+  Linux only).
+
+The budget is the size of the data plus 150 MB; since the data already
+exists before ``fit``, what ``fit`` adds must stay under 150 MB for every
+order (history is gathered per minibatch by indexing, never materialised).
+
+Run from the repository root::
+
+    python benchmarks/bench_memory.py                     # about a minute
+    python benchmarks/bench_memory.py --orders 1 3 6 12 24
+
+Prints a table and writes ``benchmarks/results/bench_memory.json``.
+"""
+
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from _common import print_table, write_json
+
+BUDGET_MB = 150.0
+
+CHILD = r"""
+import json, sys, tracemalloc
+from pathlib import Path
+sys.path.insert(0, {bench_dir!r})
+import numpy as np
+from threadpoolctl import threadpool_limits
+from _common import synthetic_motion
+from sklearn_crbm import ConditionalRBM
+
+def status(key):
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith(key + ":"):
+            return int(line.split()[1]) / 1024  # MB
+    return float("nan")
+
+n, order, dtype = {n}, {order}, {dtype!r}
+X, ids = synthetic_motion(n, 62, max(1, n // 100), dtype=dtype)
+model = ConditionalRBM(200, order=order, n_iter=1, random_state=0)
+try:
+    Path("/proc/self/clear_refs").write_text("5")  # reset the peak RSS
+except OSError:
+    pass
+rss_before, hwm_before = status("VmRSS"), status("VmHWM")
+tracemalloc.start()
+base, _ = tracemalloc.get_traced_memory()
+with threadpool_limits(1):
+    model.fit(X, sequence_ids=ids)
+_, peak = tracemalloc.get_traced_memory()
+tracemalloc.stop()
+print(json.dumps({{
+    "data_mb": X.nbytes / 2**20,
+    "traced_mb": (peak - base) / 2**20,
+    "rss_before_mb": rss_before,
+    "peak_rss_added_mb": status("VmHWM") - rss_before,
+}}))
+"""
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--frames", type=int, default=1_000_000)
+    parser.add_argument("--orders", type=int, nargs="+", default=[1, 3, 6, 12])
+    parser.add_argument("--dtype", default="float32")
+    parser.add_argument("--output", default=None)
+    args = parser.parse_args(argv)
+
+    bench_dir = str(Path(__file__).resolve().parent)
+    rows = []
+    for order in args.orders:
+        code = CHILD.format(
+            bench_dir=bench_dir, n=args.frames, order=order, dtype=args.dtype
+        )
+        result = subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, check=True
+        )
+        row = json.loads(result.stdout.strip().splitlines()[-1])
+        row.update(order=order, frames=args.frames, dtype=args.dtype)
+        row["within_budget"] = (
+            max(row["traced_mb"], row["peak_rss_added_mb"]) <= BUDGET_MB
+        )
+        rows.append(row)
+        print(f"  order {order}: {row['traced_mb']:.1f} MB traced", flush=True)
+    columns = [
+        ("frames", "frames", ",d"),
+        ("dtype", "dtype", "s"),
+        ("order", "order", "d"),
+        ("data_mb", "data MB", ".0f"),
+        ("traced_mb", "fit adds, traced MB", ".1f"),
+        ("peak_rss_added_mb", "fit adds, peak RSS MB", ".1f"),
+        ("within_budget", f"<= {BUDGET_MB:.0f} MB", "s"),
+    ]
+    for row in rows:
+        row["within_budget"] = "yes" if row["within_budget"] else "NO"
+    table = print_table(
+        rows, columns, title="Memory of fit, 62 dims, 200 hidden, 1 epoch"
+    )
+    write_json(
+        "bench_memory", {"args": vars(args), "rows": rows, "table": table}, args.output
+    )
+
+
+if __name__ == "__main__":
+    main()

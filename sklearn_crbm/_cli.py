@@ -1,0 +1,464 @@
+"""Command line: ``python -m sklearn_crbm {demo,fetch,fit,sample}``.
+
+``demo`` is the package's main job: the paper's experiments on CMU subject
+35 in a few minutes (train, fill in against nearest neighbour, generate
+walking and jogging, draw figures).
+"""
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import sklearn
+
+from ._crbm import ConditionalRBM
+from .datasets import (
+    bone_columns,
+    fetch_cmu35,
+    fetch_mit_walk,
+    get_data_home,
+    load_cmu35,
+    write_amc,
+)
+from .impute import CRBMImputer, NearestNeighborImputer
+from .metrics import (
+    fillin_angle_rmse,
+    fillin_error,
+    forward_speed,
+    nearest_style,
+    step_frequency,
+)
+from .preprocessing import make_motion_preprocessor
+
+__all__ = ["main"]
+
+# The paper's fill-in experiment: the held-out walk and jog, two body parts.
+TEST_TRIALS = (("walk", "35_29"), ("jog", "35_18"))
+BODY_PARTS = (("left leg", "lfemur"), ("upper body", "lowerback"))
+PAPER_FILLIN = {
+    ("walk", "left leg"): (8.78, 11.68),
+    ("walk", "upper body"): (20.52, 22.20),
+}
+
+
+def main(argv=None):
+    """Run the command line; returns the exit status."""
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    try:
+        with sklearn.config_context(enable_metadata_routing=True):
+            return args.run(args)
+    except FileNotFoundError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+
+
+def _parser():
+    parser = argparse.ArgumentParser(
+        prog="python -m sklearn_crbm",
+        description="Conditional RBMs for human motion (Taylor, Hinton & Roweis 2006).",
+    )
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+
+    demo = commands.add_parser(
+        "demo",
+        help="the paper's demo on CMU 35: train, fill in, generate, draw",
+        description="Train a CRBM on CMU subject 35, print the fill-in table "
+        "against nearest neighbour, generate walking and jogging, and write "
+        "figures. The defaults take a few minutes on 2 cores; --full runs the "
+        "paper's 4000 epochs and 100 fill-in repeats.",
+    )
+    _add_data_home(demo)
+    _add_model_options(demo, n_iter=1000)
+    demo.add_argument(
+        "--output",
+        type=Path,
+        default=Path("crbm_demo"),
+        help="folder for figures and generated motion (default: %(default)s)",
+    )
+    demo.add_argument(
+        "--n-repeats",
+        type=int,
+        default=20,
+        help="single-draw fills averaged per case (paper: 100)",
+    )
+    demo.add_argument(
+        "--n-particles",
+        type=int,
+        default=20,
+        help="weighted particles per fill-in chain (1: the original scheme)",
+    )
+    demo.add_argument(
+        "--n-frames",
+        type=int,
+        default=300,
+        help="frames generated per sequence (default: %(default)s)",
+    )
+    demo.add_argument(
+        "--full",
+        action="store_true",
+        help="the paper's full size: 4000 epochs, 100 fill-in repeats",
+    )
+    demo.add_argument("--no-figures", action="store_true", help="skip the figures")
+    demo.set_defaults(run=run_demo)
+
+    fetch = commands.add_parser(
+        "fetch", help="download CMU 35 and the MIT walking data"
+    )
+    _add_data_home(fetch)
+    fetch.set_defaults(run=run_fetch)
+
+    fit = commands.add_parser(
+        "fit", help="train preprocessing + CRBM on CMU 35 and save it with joblib"
+    )
+    _add_data_home(fit)
+    _add_model_options(fit, n_iter=1000)
+    fit.add_argument("--output", type=Path, default=Path("crbm_cmu35.joblib"))
+    fit.set_defaults(run=run_fit)
+
+    sample = commands.add_parser(
+        "sample", help="generate motion from a saved model and write AMC files"
+    )
+    _add_data_home(sample)
+    sample.add_argument("model", type=Path, help="a file written by the fit command")
+    sample.add_argument(
+        "--style",
+        choices=("walk", "jog"),
+        default="walk",
+        help="seed the generation with frames of this style",
+    )
+    sample.add_argument("--n-frames", type=int, default=300)
+    sample.add_argument("--n-sequences", type=int, default=1)
+    sample.add_argument("--hidden-noise", type=float, default=0.0)
+    sample.add_argument("--seed", type=int, default=0)
+    sample.add_argument(
+        "--output",
+        type=Path,
+        default=Path("generated"),
+        help="prefix of the AMC files written",
+    )
+    sample.set_defaults(run=run_sample)
+    return parser
+
+
+def _add_data_home(parser):
+    parser.add_argument(
+        "--data-home",
+        type=Path,
+        default=None,
+        help="data folder (default: $SKLEARN_CRBM_DATA, else ~/sklearn_crbm_data)",
+    )
+
+
+def _add_model_options(parser, n_iter):
+    parser.add_argument("--n-components", type=int, default=200)
+    parser.add_argument("--order", type=int, default=3)
+    parser.add_argument(
+        "--n-iter",
+        type=int,
+        default=n_iter,
+        help="training epochs (default: %(default)s; the paper: 4000)",
+    )
+    parser.add_argument("--seed", type=int, default=0)
+
+
+def _load_cmu35(data_home, subset):
+    try:
+        return load_cmu35(data_home, subset=subset)
+    except FileNotFoundError as exc:
+        home = get_data_home(data_home)
+        raise FileNotFoundError(
+            f"{exc}\nThe CMU subject 35 data is not in {home}. Download it with\n"
+            f"    python -m sklearn_crbm fetch --data-home {home}\n"
+            "or point --data-home (or $SKLEARN_CRBM_DATA) at a folder that holds it."
+        ) from None
+
+
+# ----------------------------------------------------------------- demo
+def run_demo(args):
+    if args.full:
+        args.n_iter, args.n_repeats = 4000, 100
+    start = time.perf_counter()
+    train = _load_cmu35(args.data_home, "train")
+    test = _load_cmu35(args.data_home, "test")
+    print(
+        f"CMU subject 35: {len(train.data)} training frames in "
+        f"{len(train.sequence_names)} trials, test trials "
+        f"{', '.join(test.sequence_names)}"
+    )
+
+    preprocessor = make_motion_preprocessor(train.skeleton)
+    Z = preprocessor.fit_transform(train.data, sequence_ids=train.sequence_ids)
+    names = preprocessor.get_feature_names_out()
+    print(
+        f"preprocessed to {Z.shape[1]} dimensions "
+        "(exp maps, body-centred root, z-scores)"
+    )
+
+    model = ConditionalRBM(
+        args.n_components,
+        order=args.order,
+        n_iter=args.n_iter,
+        random_state=args.seed,
+        verbose=max(1, args.n_iter // 10),
+    )
+    print(f"\ntraining {model!r}")
+    imputer = CRBMImputer(model, n_particles=args.n_particles, random_state=args.seed)
+    imputer.fit(Z, sequence_ids=train.sequence_ids)
+    model = imputer.estimator_
+
+    cases = _fillin_cases(preprocessor, train, test, names)
+    table = _fillin_table(preprocessor, imputer, Z, cases, args.n_repeats, args.seed)
+    generated = _generate_styles(model, preprocessor, Z, train, names, args)
+    if not args.no_figures:
+        _draw(args.output, model, preprocessor, train, cases, table, generated)
+    print(f"\ndone in {time.perf_counter() - start:.0f} s")
+    return 0
+
+
+def _fillin_cases(preprocessor, train, test, names):
+    """The paper's cases: erase a body part from halfway to the end."""
+    cases = {}
+    for motion, trial in TEST_TRIALS:
+        raw = test.data[test.sequence_ids == list(test.sequence_names).index(trial)]
+        Z = preprocessor.transform(raw)
+        first = len(Z) - len(Z) // 2
+        for part, top_bone in BODY_PARTS:
+            bones = train.skeleton.descendants(top_bone)
+            mask = np.zeros(Z.shape, dtype=bool)
+            mask[first:, bone_columns(names, bones, strict=False)] = True
+            raw_mask = np.zeros(raw.shape, dtype=bool)
+            raw_mask[first:, bone_columns(train.feature_names, bones, strict=False)] = (
+                True
+            )
+            cases[motion, part] = dict(
+                Z=Z, raw=raw, mask=mask, raw_mask=raw_mask, trial=trial, first=first
+            )
+    return cases
+
+
+def _fillin_errors(preprocessor, case, filled):
+    raw = preprocessor.inverse_transform(filled)
+    return (
+        fillin_error(case["Z"], filled, missing_mask=case["mask"]),
+        fillin_angle_rmse(case["raw"], raw, missing_mask=case["raw_mask"]),
+    )
+
+
+def _fillin_table(preprocessor, imputer, Z_train, cases, n_repeats, seed):
+    nearest = NearestNeighborImputer().fit(Z_train)
+    print(
+        f"\nfilling in (the paper's error, summed over the erased frames; "
+        f"CRBM: mean of {n_repeats} single draws)"
+    )
+    print(
+        f"{'sequence':<14}{'erased':<12}{'CRBM':>8}{'NN':>8}{'ratio':>7}"
+        f"{'CRBM°':>8}{'NN°':>8}   paper (CRBM / NN)"
+    )
+    table = {}
+    for (motion, part), case in cases.items():
+        X_missing = np.where(case["mask"], np.nan, case["Z"])
+        draws = imputer.sample(X_missing, n_samples=n_repeats, random_state=seed)
+        crbm = np.mean([_fillin_errors(preprocessor, case, d) for d in draws], axis=0)
+        nn_fill = nearest.transform(X_missing)
+        nn = _fillin_errors(preprocessor, case, nn_fill)
+        paper = PAPER_FILLIN.get((motion, part))
+        paper_text = f"{paper[0]:.2f} / {paper[1]:.2f}" if paper else "-"
+        print(
+            f"{motion + ' ' + case['trial']:<14}{part:<12}{crbm[0]:8.2f}{nn[0]:8.2f}"
+            f"{crbm[0] / nn[0]:7.2f}{crbm[1]:8.2f}{nn[1]:8.2f}   {paper_text}"
+        )
+        table[motion, part] = dict(crbm=crbm, nn=nn, draw=draws[0], nn_fill=nn_fill)
+    return table
+
+
+def _generate_styles(model, preprocessor, Z, train, names, args):
+    """Seed with walk frames and with jog frames; classify what comes out."""
+    ids = train.sequence_ids
+    styles = np.asarray(train.motion)[ids]
+    reference = _gait_statistics(Z, ids, names)
+    reference_styles = np.asarray(train.motion)
+    print(
+        f"\ngenerating {args.n_frames} frames per sequence, 3 sequences per seed style"
+    )
+    print(f"{'seeded with':<12}{'speed':>8}{'step Hz':>9}   classified as")
+    generated = {}
+    rng = np.random.default_rng(args.seed)
+    for style in ("walk", "jog"):
+        starts = rng.choice(np.flatnonzero(styles == style), 3, replace=False)
+        seeds = np.stack([_window_before(Z, ids, s, model.order) for s in starts])
+        frames = model.sample(args.n_frames, history=seeds, random_state=args.seed)
+        gen_ids = np.repeat(np.arange(3), args.n_frames)
+        stats = _gait_statistics(frames, gen_ids, names)
+        labels = nearest_style(stats, reference, reference_styles)
+        for row, label in zip(stats, labels, strict=True):
+            print(f"{style:<12}{row[0]:8.3f}{row[1]:9.2f}   {label}")
+        generated[style] = (frames, gen_ids)
+    for style in ("walk", "jog"):
+        real = reference[reference_styles == style]
+        print(
+            f"{'real ' + style:<12}{real[:, 0].mean():8.3f}"
+            f"{np.nanmean(real[:, 1]):9.2f}"
+            "   (training mean)"
+        )
+    return generated
+
+
+def _gait_statistics(X, sequence_ids, names):
+    legs = [
+        n for n in names if n.startswith(("lfemur_", "rfemur_", "ltibia_", "rtibia_"))
+    ]
+    return np.column_stack(
+        [
+            forward_speed(X, sequence_ids=sequence_ids, feature_names=names),
+            step_frequency(
+                X, sequence_ids=sequence_ids, features=legs, feature_names=names
+            ),
+        ]
+    )
+
+
+def _window_before(Z, sequence_ids, frame, order):
+    """``order`` frames of one sequence ending at ``frame`` (moved inside if needed)."""
+    same = np.flatnonzero(sequence_ids == sequence_ids[frame])
+    end = min(max(frame, same[0] + order), same[-1] + 1)
+    return Z[end - order : end]
+
+
+def _draw(output, model, preprocessor, train, cases, table, generated):
+    from .plotting import (
+        plot_filled_channels,
+        plot_hidden_activations,
+        plot_motion_strip,
+    )
+
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print(
+            "\nmatplotlib is not installed: no figures "
+            "(pip install 'sklearn_crbm[plot]')"
+        )
+        return
+    output.mkdir(parents=True, exist_ok=True)
+    written = []
+    for style, (frames, gen_ids) in generated.items():
+        raw = preprocessor.inverse_transform(frames, sequence_ids=gen_ids)
+        first = raw[gen_ids == 0][:120]
+        fig, ax = plt.subplots(figsize=(12, 3))
+        plot_motion_strip(
+            train.skeleton, first, feature_names=train.feature_names, step=6, ax=ax
+        )
+        ax.set_title(f"generated from a {style} seed (every 6th frame)")
+        written.append(_save(fig, output / f"generated_{style}.png"))
+        write_amc(
+            output / f"generated_{style}.amc",
+            raw[gen_ids == 0],
+            train.skeleton,
+            feature_names=train.feature_names,
+        )
+        written.append(output / f"generated_{style}.amc")
+    case, result = cases["walk", "left leg"], table["walk", "left leg"]
+    names = preprocessor.get_feature_names_out()
+    axes = plot_filled_channels(
+        case["Z"],
+        result["draw"],
+        result["nn_fill"],
+        features=["lfemur_ex", "lfemur_ey", "lfemur_ez"],
+        feature_names=names,
+        missing_from=case["first"],
+    )
+    fig = np.ravel(axes)[0].figure
+    written.append(_save(fig, output / "fillin_left_hip.png"))
+    walk_seq = np.flatnonzero(np.asarray(train.motion) == "walk")[0]
+    jog_seq = np.flatnonzero(np.asarray(train.motion) == "jog")[0]
+    keep = np.isin(train.sequence_ids, [walk_seq, jog_seq])
+    Z = preprocessor.transform(train.data[keep], sequence_ids=train.sequence_ids[keep])
+    fig, ax = plt.subplots(figsize=(10, 4))
+    plot_hidden_activations(
+        model.transform(Z, sequence_ids=train.sequence_ids[keep]), ax=ax
+    )
+    ax.set_title("hidden units on a walk then a jog")
+    written.append(_save(fig, output / "hidden_activations.png"))
+    print("\nwrote " + ", ".join(str(p) for p in written))
+
+
+def _save(fig, path):
+    fig.savefig(path, dpi=100, bbox_inches="tight")
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+    return path
+
+
+# ---------------------------------------------------------- other commands
+def run_fetch(args):
+    home = get_data_home(args.data_home)
+    print(f"downloading into {home}")
+    fetch_cmu35(home)
+    fetch_mit_walk(home)
+    print("done")
+    return 0
+
+
+def run_fit(args):
+    import joblib
+    from sklearn.pipeline import Pipeline
+
+    train = _load_cmu35(args.data_home, "train")
+    pipeline = Pipeline(
+        make_motion_preprocessor(train.skeleton).steps
+        + [
+            (
+                "crbm",
+                ConditionalRBM(
+                    args.n_components,
+                    order=args.order,
+                    n_iter=args.n_iter,
+                    random_state=args.seed,
+                    verbose=max(1, args.n_iter // 10),
+                ),
+            )
+        ]
+    )
+    pipeline.fit(train.data, sequence_ids=train.sequence_ids)
+    joblib.dump(pipeline, args.output)
+    print(f"saved the fitted pipeline to {args.output}")
+    return 0
+
+
+def run_sample(args):
+    import joblib
+
+    pipeline = joblib.load(args.model)
+    crbm, preprocessor = pipeline[-1], pipeline[:-1]
+    train = _load_cmu35(args.data_home, "train")
+    Z = preprocessor.transform(train.data, sequence_ids=train.sequence_ids)
+    styles = np.asarray(train.motion)[train.sequence_ids]
+    rng = np.random.default_rng(args.seed)
+    starts = rng.choice(np.flatnonzero(styles == args.style), args.n_sequences)
+    width = max(crbm.order, crbm.hidden_order or crbm.order, 1)
+    seeds = np.stack([_window_before(Z, train.sequence_ids, s, width) for s in starts])
+    frames = crbm.sample(
+        args.n_frames,
+        history=seeds,
+        hidden_noise=args.hidden_noise,
+        random_state=args.seed,
+    )
+    gen_ids = np.repeat(np.arange(args.n_sequences), args.n_frames)
+    raw = preprocessor.inverse_transform(frames, sequence_ids=gen_ids)
+    for k in range(args.n_sequences):
+        path = Path(f"{args.output}_{k}.amc")
+        write_amc(
+            path, raw[gen_ids == k], train.skeleton, feature_names=train.feature_names
+        )
+        print(f"wrote {path}")
+    return 0

@@ -1,0 +1,543 @@
+"""On-line filling of missing channels with a conditional RBM (paper §4.4)."""
+
+from numbers import Integral
+
+import numpy as np
+from sklearn.base import (
+    BaseEstimator,
+    OneToOneFeatureMixin,
+    TransformerMixin,
+    _fit_context,
+    clone,
+)
+from sklearn.utils import check_random_state
+from sklearn.utils._missing import is_scalar_nan
+from sklearn.utils._param_validation import HasMethods, Interval, MissingValues
+from sklearn.utils.validation import check_is_fitted
+
+from .._crbm import ConditionalRBM
+from .._crbm_math import (
+    dynamic_biases,
+    hidden_probabilities,
+    observed_log_likelihood,
+    stacked_gibbs_frames,
+    stacked_prediction,
+)
+from ..utils._fitting import unfitted_on_error
+from ..utils._sequences import check_sequence_ids
+from ._base import check_imputer_input, complete_runs
+
+# Rounds of "fill, then use the fill as its own past" for the first frame of a
+# sequence, which has no past frames.
+_FIRST_FRAME_ROUNDS = 3
+# Mean-field iterations of the one-step prediction that weights particles.
+_PREDICTION_STEPS = 10
+# history_noise of the default model: the value measured to remove the drift
+# of on-line fill-in on CMU 35 (benchmarks/paper_fillin.py, 5 training seeds).
+DEFAULT_HISTORY_NOISE = 0.4
+
+
+def _rng_from(random_state):
+    """A numpy Generator seeded from a scikit-learn ``random_state``."""
+    seed = check_random_state(random_state).randint(np.iinfo(np.int32).max)
+    return np.random.default_rng(seed)
+
+
+def _layers(estimator):
+    """The fitted CRBM layers of a ConditionalRBM or a StackedCRBM, bottom first."""
+    if hasattr(estimator, "layers_"):
+        return list(estimator.layers_)
+    return [estimator]
+
+
+class CRBMImputer(OneToOneFeatureMixin, TransformerMixin, BaseEstimator):
+    """Fill missing channels on-line with a conditional RBM (paper §4.4).
+
+    ``fit`` trains a clone of ``estimator`` on complete sequences.
+    ``transform`` then fills the frames of each sequence in time order, as
+    they would arrive from a motion-capture system: frame ``t`` is filled
+    from the already filled frames before it (through the directed
+    connections) and from its own observed channels (through the symmetric
+    ones), never from later frames.  The observed channels are clamped, the
+    missing ones start at their value in the previous frame, and alternating
+    Gibbs sampling follows: hidden units sampled given the frame and its
+    history, visibles set to their mean given the hidden units, ``n_gibbs``
+    times, then one mean-field step (the generation scheme of the original
+    code, with the observed channels held fixed).
+
+    Parameters
+    ----------
+    estimator : ConditionalRBM or StackedCRBM, default=None
+        The model, cloned and trained by :meth:`fit`.  ``None`` means
+        ``ConditionalRBM(history_noise=0.4)``: trained on noisy histories so
+        that on-line fills do not drift (see Notes; with the paper's plain
+        schedule the filled upper body of a walk drifts for some training
+        seeds).  Standardise the data first (e.g. with
+        :class:`~sklearn_crbm.preprocessing.StandardScaler`): the visible
+        units have unit variance.
+    n_gibbs : int, default=30
+        Alternating Gibbs iterations per frame.
+    n_draws : int, default=1
+        Number of independent fills averaged by :meth:`transform`: one
+        draw is one sample of the model's on-line fill, the average of many
+        estimates its posterior mean, which has a lower squared error.
+    n_particles : int, default=1
+        Chains per draw.  With more than one, each draw is a particle
+        filter: before every frame, the draw's particles are resampled in
+        proportion to how well each one's past predicts the frame's observed
+        channels, and the draw's fill of the frame is the mean of its
+        particles' fills (see Notes).  ``1`` is the paper's single chain.
+    missing_values : int, float, str, np.nan or None, default=np.nan
+        The placeholder for missing values; all its occurrences are filled.
+    random_state : int, RandomState instance or None, default=None
+        Seeds the Gibbs sampling of :meth:`transform`; pass an int for
+        reproducible fills.  The estimator keeps its own ``random_state``
+        for training.
+
+    Attributes
+    ----------
+    estimator_ : ConditionalRBM or StackedCRBM
+        The fitted clone of ``estimator``.
+    mean_ : ndarray of shape (n_features_in_,)
+        Mean training frame: where the missing channels of the first frame
+        of a sequence start.
+    n_features_in_ : int
+        Number of features seen during :term:`fit`.
+    feature_names_in_ : ndarray of shape (`n_features_in_`,)
+        Names of features seen during :term:`fit`. Defined only when `X`
+        has feature names that are all strings.
+
+    See Also
+    --------
+    NearestNeighborImputer : The paper's baseline.
+    ConditionalRBM : The model.
+
+    Notes
+    -----
+    *Start of a sequence.*  The first frame of a sequence has no past: its
+    missing channels start at the training mean and the model is run with
+    the frame standing in for its own past (edge padding, as
+    :meth:`ConditionalRBM.transform`), three times over, each time with the
+    latest fill as the past.  Frames ``1`` to ``order - 1`` use the frames
+    they have, the first frame repeated for the rest.
+
+    *Drift, and how to avoid it.*  On-line, each frame is filled given the
+    model's own fills of the frames before it, so fill errors feed back
+    through the directed connections.  A model trained, as in the paper,
+    on clean histories only has never seen a past with its own errors in
+    it and need not correct them: with the upper body of a walk missing,
+    the filled arms can slide into the jogging arm carriage and stay there,
+    for some training seeds and not others, although the same model fills
+    every frame well when given the *true* past.  Train the estimator with
+    noisy histories (``ConditionalRBM(history_noise=0.4)`` for standardised
+    motion) so that it learns to pull a perturbed past back towards the
+    data; on CMU subject 35 this removes the drift for every seed (see
+    ``benchmarks/paper_fillin.py``).
+
+    *Particles.*  A drifting chain also predicts the *observed* channels
+    badly.  With ``n_particles > 1`` every draw is a sequential Monte Carlo
+    filter with the clamped Gibbs run as proposal: before frame ``t`` each
+    particle is weighted by the likelihood of frame ``t``'s observed
+    channels under its own one-step prediction (mean field from its past;
+    Gaussian with the model's unit variance), the particles are resampled
+    (systematic resampling), and each then fills frame ``t`` by clamped
+    Gibbs sampling.  Particles that have drifted are replaced by copies of
+    those that explain the data.  The filter stays on-line: frame ``t``'s
+    fill never changes afterwards.
+
+    *Wholly missing frames* are generated from their past alone, as
+    :meth:`ConditionalRBM.sample` does, starting from the previous frame.
+    Frames without missing channels are copied and cost nothing.
+
+    All sequences advance frame by frame together, and so do the
+    ``n_draws * n_particles`` chains: the cost is about ``2 * n_gibbs``
+    matrix products of ``n_draws * n_particles`` rows per frame of the
+    longest sequence.  Memory is ``O(n_draws * n_frames * n_features)``
+    for the output plus the recent past of every chain.
+
+    The estimator may be a :class:`ConditionalRBM` or a
+    :class:`~sklearn_crbm.StackedCRBM`.  With a stack each Gibbs iteration
+    passes the frame up the lower layers (hidden probabilities), takes one
+    alternating step of the top layer and passes the result down as visible
+    means (the original two-level generation scheme), with the observed
+    channels clamped; every layer's directed connections see that layer's
+    own on-line past.
+
+    References
+    ----------
+    G. W. Taylor, G. E. Hinton and S. Roweis. Modeling Human Motion Using
+    Binary Latent Variables. NIPS 19, 2006, Section 4.4.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn_crbm import ConditionalRBM
+    >>> from sklearn_crbm.datasets import make_oscillations
+    >>> from sklearn_crbm.impute import CRBMImputer
+    >>> X, ids = make_oscillations(n_sequences=6, n_frames=60, random_state=0)
+    >>> model = ConditionalRBM(n_components=16, order=2, n_iter=30,
+    ...                        history_noise=0.4, random_state=0)
+    >>> imputer = CRBMImputer(model, n_draws=5, random_state=0)
+    >>> imputer.fit(X[ids < 5], sequence_ids=ids[ids < 5])
+    CRBMImputer(...)
+    >>> X_test = X[ids == 5].copy()
+    >>> X_test[30:, :2] = np.nan           # two channels lost half-way through
+    >>> X_filled = imputer.transform(X_test)
+    >>> bool(np.isnan(X_filled).any())
+    False
+    >>> bool(np.array_equal(X_filled[:, 2:], X_test[:, 2:]))
+    True
+    """
+
+    _parameter_constraints: dict = {
+        "estimator": [HasMethods(["fit", "transform"]), None],
+        "n_gibbs": [Interval(Integral, 0, None, closed="left")],
+        "n_draws": [Interval(Integral, 1, None, closed="left")],
+        "n_particles": [Interval(Integral, 1, None, closed="left")],
+        "missing_values": [MissingValues()],
+        "random_state": ["random_state"],
+    }
+
+    # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
+    # search passes ``sequence_ids`` to these methods without being asked.
+    __metadata_request__fit = {"sequence_ids": True}
+    __metadata_request__transform = {"sequence_ids": True}
+
+    def __init__(
+        self,
+        estimator=None,
+        *,
+        n_gibbs=30,
+        n_draws=1,
+        n_particles=1,
+        missing_values=np.nan,
+        random_state=None,
+    ):
+        self.estimator = estimator
+        self.n_gibbs = n_gibbs
+        self.n_draws = n_draws
+        self.n_particles = n_particles
+        self.missing_values = missing_values
+        self.random_state = random_state
+
+    @_fit_context(prefer_skip_nested_validation=False)
+    def fit(self, X, y=None, *, sequence_ids=None):
+        """Train the model on complete sequences.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            Training sequences, stacked, each contiguous and in time order.
+            The model learns from complete frames only: a frame with a
+            missing value is left out and splits its sequence in two.
+        y : None
+            Ignored.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        self : CRBMImputer
+            The fitted imputer.
+        """
+        with unfitted_on_error(self):
+            X, mask = check_imputer_input(self, X, reset=True)
+            rows, run_ids = complete_runs(mask, sequence_ids)
+            X = X[rows]
+            estimator = self.estimator
+            if estimator is None:
+                estimator = ConditionalRBM(history_noise=DEFAULT_HISTORY_NOISE)
+            self.estimator_ = clone(estimator).fit(X, sequence_ids=run_ids)
+            self.mean_ = X.mean(axis=0)
+        return self
+
+    def fit_transform(self, X, y=None, *, sequence_ids=None):
+        """Fit on ``X``, then fill its missing values on-line.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            Training sequences; the model learns from their complete frames
+            (see :meth:`fit`), then their missing values are filled.
+        y : None
+            Ignored.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        X_filled : ndarray of shape (n_frames, n_features)
+            ``X`` with no missing value left, as a new array.
+        """
+        return self.fit(X, sequence_ids=sequence_ids).transform(
+            X, sequence_ids=sequence_ids
+        )
+
+    def transform(self, X, *, sequence_ids=None):
+        """Fill every missing value of ``X`` on-line.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            Sequences with missing values, stacked, each contiguous and in
+            time order.  Observed values come back unchanged.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        X_filled : ndarray of shape (n_frames, n_features)
+            ``X`` with each missing value replaced by the average of
+            ``n_draws`` on-line fills; no missing value is left.
+        """
+        return self._impute(X, sequence_ids, self.n_draws, self.random_state, True)
+
+    def sample(self, X, n_samples=1, *, sequence_ids=None, random_state=None):
+        """Draw independent on-line fills of ``X`` (multiple imputation).
+
+        Each fill is one run of the procedure of :meth:`transform` with a
+        single draw (with ``n_particles > 1``, one run of the particle
+        filter: the mean of its particles); :meth:`transform` with
+        ``n_draws=k`` and the same ``random_state`` returns the mean of the
+        ``k`` fills this method draws.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            Sequences with missing values.
+        n_samples : int, default=1
+            Number of fills.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+        random_state : int, RandomState instance or None, default=None
+            Seeds the sampling; ``None`` uses the imputer's ``random_state``.
+
+        Returns
+        -------
+        X_filled : ndarray of shape (n_samples, n_frames, n_features)
+            The fills; observed values are unchanged in each.
+        """
+        if isinstance(n_samples, bool) or not isinstance(n_samples, Integral):
+            raise ValueError(f"n_samples must be an integer >= 1, got {n_samples!r}.")
+        if n_samples < 1:
+            raise ValueError(f"n_samples must be an integer >= 1, got {n_samples!r}.")
+        random_state = self.random_state if random_state is None else random_state
+        return self._impute(X, sequence_ids, int(n_samples), random_state, False)
+
+    def _impute(self, X, sequence_ids, n_draws, random_state, average):
+        check_is_fitted(self)
+        X, mask = check_imputer_input(self, X, reset=False)
+        sequences = check_sequence_ids(sequence_ids, X.shape[0])
+        if not mask.any():
+            return X if average else np.broadcast_to(X, (n_draws, *X.shape)).copy()
+        rng = _rng_from(random_state)
+        layers = [layer._params() for layer in _layers(self.estimator_)]
+        draws = self._fill(layers, X, mask, sequences, n_draws, rng)
+        if average:
+            X[mask] = draws.mean(axis=0)[mask]
+            return X
+        out = np.broadcast_to(X, draws.shape).copy()
+        out[:, mask] = draws[:, mask]
+        return out
+
+    def _fill(self, layers, X, mask, sequences, n_draws, rng):
+        """``n_draws`` on-line fills, all sequences and draws advancing together.
+
+        Every draw runs ``n_particles`` chains.  Only the recent past is
+        kept: for every layer, chain and sequence the last ``n_lags`` values
+        of that layer's visible units (``windows``, most recent first; the
+        frames themselves for the bottom layer, the hidden probabilities of
+        the layer below for the others).  A frame's fill is final once the
+        frame is processed.
+
+        Returns an array of shape ``(n_draws, n_frames, n_features)`` in the
+        model's dtype.
+        """
+        n_frames, n_features = X.shape
+        dtype = layers[0].dtype
+        n_chains = n_draws * self.n_particles
+        X = X.astype(dtype)
+        out = np.broadcast_to(X, (n_draws, n_frames, n_features)).copy()
+        mean = self.mean_.astype(dtype)
+        starts, lengths = sequences.starts, sequences.lengths
+        windows = [
+            np.empty(
+                (n_chains, len(starts), max(p.n_lags, 1), p.n_features), dtype=dtype
+            )
+            for p in layers
+        ]
+        for step in range(int(lengths.max(initial=0))):
+            active = np.flatnonzero(lengths > step)
+            rows = starts[active] + step
+            missing = mask[rows]
+            need = np.flatnonzero(missing.any(axis=1))
+            frames = np.where(missing, mean, X[rows])
+            current = np.broadcast_to(frames, (n_chains, *frames.shape)).copy()
+            observed = np.broadcast_to(
+                ~missing[need], (n_chains, len(need), n_features)
+            ).reshape(-1, n_features)
+            if step == 0:
+                # No past: the frame stands in for it (edge padding), and the
+                # fill is repeated with the latest fill as the past.
+                for _ in range(_FIRST_FRAME_ROUNDS if len(need) else 0):
+                    biases = _edge_biases(layers, current[:, need])
+                    current[:, need] = self._fill_frames(
+                        layers, current[:, need], biases, observed, rng
+                    )
+                biases = _edge_biases(layers, current)
+            else:
+                if self.n_particles > 1 and len(need):
+                    self._resample(
+                        layers,
+                        windows,
+                        active[need],
+                        frames[need],
+                        ~missing[need],
+                        n_draws,
+                        rng,
+                    )
+                biases = _window_biases(layers, windows, active)
+                if len(need):
+                    start = np.where(
+                        missing[need], windows[0][:, active[need], 0], frames[need]
+                    )
+                    current[:, need] = self._fill_frames(
+                        layers, start, [b[:, need] for b in biases], observed, rng
+                    )
+            if len(need):
+                fills = current[:, need].reshape(
+                    n_draws, self.n_particles, len(need), -1
+                )
+                out[:, rows[need]] = fills.mean(axis=1)
+            _push(layers, windows, active, current, biases, first=step == 0)
+        return out
+
+    def _fill_frames(self, layers, start, biases, observed, rng):
+        """One clamped Gibbs run for every (chain, frame) pair.
+
+        ``start`` has shape ``(n_chains, n_rows, n_features)``; ``biases``
+        holds every layer's ``(n_chains, n_rows, n_visible + n_hidden)``
+        dynamic biases.
+        """
+        shape = start.shape
+        visible_biases, hidden_biases = _split_biases(layers, biases)
+        frames = stacked_gibbs_frames(
+            layers,
+            start.reshape(-1, shape[2]),
+            visible_biases,
+            hidden_biases,
+            self.n_gibbs,
+            rng,
+            observed_mask=observed,
+        )
+        return frames.reshape(shape)
+
+    def _resample(self, layers, windows, seqs, frames, observed, n_draws, rng):
+        """Resample each draw's particles by how well they explain the observed data.
+
+        A particle's weight is the likelihood of the frame's observed
+        channels under its own one-step prediction
+        (:func:`~sklearn_crbm._crbm_math.observed_log_likelihood`); each
+        draw's particles are resampled (systematic resampling) and the pasts
+        of the chosen ancestors copied, before the frame is filled.
+        """
+        n_chains = windows[0].shape[0]
+        n_particles = n_chains // n_draws
+        n_features = frames.shape[1]
+        visible_biases, hidden_biases = _split_biases(
+            layers, _window_biases(layers, windows, seqs)
+        )
+        prediction = stacked_prediction(
+            layers, visible_biases, hidden_biases, _PREDICTION_STEPS
+        )
+        log_weights = observed_log_likelihood(
+            layers[0],
+            prediction,
+            np.broadcast_to(frames, (n_chains, *frames.shape)).reshape(-1, n_features),
+            np.broadcast_to(observed, (n_chains, *observed.shape)).reshape(
+                -1, n_features
+            ),
+        ).reshape(n_draws, n_particles, len(seqs))
+        log_weights -= log_weights.max(axis=1, keepdims=True)
+        cumulative = np.cumsum(np.exp(log_weights), axis=1)
+        cumulative /= cumulative[:, -1:]
+        positions = (
+            rng.random((n_draws, 1, len(seqs))) + np.arange(n_particles)[:, None]
+        ) / n_particles
+        # ancestor of particle i: how many cumulative weights lie below position i
+        ancestors = (cumulative[:, None, :, :] < positions[:, :, None, :]).sum(axis=2)
+        np.minimum(ancestors, n_particles - 1, out=ancestors)
+        chains = ancestors + (np.arange(n_draws) * n_particles)[:, None, None]
+        chains = chains.reshape(n_chains, len(seqs))
+        for window in windows:
+            window[:, seqs] = window[chains, seqs[None, :]]
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
+        return tags
+
+
+def _split_biases(layers, biases):
+    """Per-layer ``(..., n_visible + n_hidden)`` biases -> two lists of 2-D arrays."""
+    visible, hidden = [], []
+    for params, both in zip(layers, biases, strict=True):
+        both = both.reshape(-1, both.shape[-1])
+        visible.append(both[:, : params.n_features])
+        hidden.append(both[:, params.n_features :])
+    return visible, hidden
+
+
+def _layer_biases(params, history):
+    """Dynamic biases ``[visible, hidden]`` of ``(n_chains, n_rows, ...)`` histories."""
+    n_chains, n_rows = history.shape[:2]
+    flat = history.reshape(n_chains * n_rows, -1)[
+        :, : params.n_lags * params.n_features
+    ]
+    visible_bias, hidden_bias = dynamic_biases(params, flat)
+    return np.concatenate((visible_bias, hidden_bias), axis=1).reshape(
+        n_chains, n_rows, -1
+    )
+
+
+def _window_biases(layers, windows, seqs):
+    """Every layer's dynamic biases for the next frame of sequences ``seqs``."""
+    return [_layer_biases(p, w[:, seqs]) for p, w in zip(layers, windows, strict=True)]
+
+
+def _representations(layers, frames, biases):
+    """The frame, then every lower layer's hidden probabilities, bottom first."""
+    values = [frames]
+    _, hidden_biases = _split_biases(layers, biases)
+    for params, hidden_bias in zip(layers[:-1], hidden_biases[:-1], strict=True):
+        flat = values[-1].reshape(-1, params.n_features)
+        values.append(
+            hidden_probabilities(params, flat, hidden_bias).reshape(
+                *frames.shape[:2], -1
+            )
+        )
+    return values
+
+
+def _edge_biases(layers, frames):
+    """Biases with each layer's past replaced by the frame's own value (edge pad)."""
+    biases = []
+    values = frames
+    for k, params in enumerate(layers):
+        history = np.tile(values, (1, 1, max(params.n_lags, 1)))
+        biases.append(_layer_biases(params, history))
+        if k + 1 < len(layers):
+            pair = [params, layers[k + 1]]
+            values = _representations(pair, values, biases[-1:] * 2)[1]
+    return biases
+
+
+def _push(layers, windows, seqs, frames, biases, first):
+    """Add a processed frame (and its representations) to the windows of ``seqs``."""
+    values = _representations(layers, frames, biases)
+    for window, value in zip(windows, values, strict=True):
+        if first:
+            window[:, seqs] = value[:, :, None, :]
+        else:
+            window[:, seqs, 1:] = window[:, seqs, :-1]
+            window[:, seqs, 0] = value

@@ -1,0 +1,190 @@
+"""The paper's baseline: fill each frame from its nearest training frame."""
+
+import numpy as np
+from sklearn.base import (
+    BaseEstimator,
+    OneToOneFeatureMixin,
+    TransformerMixin,
+    _fit_context,
+)
+from sklearn.utils._missing import is_scalar_nan
+from sklearn.utils._param_validation import MissingValues
+from sklearn.utils.validation import check_is_fitted
+
+from ..utils._fitting import unfitted_on_error
+from ..utils._sequences import check_sequence_ids
+from ._base import check_imputer_input, complete_runs
+
+# Distances computed at once: bounds memory to about 32 MB of float64.
+_MAX_DISTANCES = 1 << 22
+
+
+class NearestNeighborImputer(OneToOneFeatureMixin, TransformerMixin, BaseEstimator):
+    """Fill missing channels from the nearest training frame (paper §4.4 baseline).
+
+    For each frame, the Euclidean distance over that frame's observed
+    channels is computed to every training frame, and the frame's missing
+    channels are copied from the closest one.  This is the nearest-neighbour
+    interpolation Taylor, Hinton & Roweis (2006) compare their model with:
+    frames are matched independently, so the filled channels carry no
+    temporal continuity.  Each frame may miss any set of channels; frames
+    that miss the same set are matched together, in chunks that bound
+    memory.
+
+    Parameters
+    ----------
+    missing_values : int, float, str, np.nan or None, default=np.nan
+        The placeholder for missing values; all its occurrences are filled.
+
+    Attributes
+    ----------
+    mean_ : ndarray of shape (n_features_in_,)
+        Mean training frame: the fill of wholly missing frames that have no
+        filled frame before them in their sequence.
+    n_features_in_ : int
+        Number of features seen during :term:`fit`.
+    feature_names_in_ : ndarray of shape (`n_features_in_`,)
+        Names of features seen during :term:`fit`. Defined only when `X`
+        has feature names that are all strings.
+
+    See Also
+    --------
+    CRBMImputer : Fills in on-line with a conditional RBM.
+    sklearn.impute.KNNImputer : Averages ``k`` neighbours, over the channels
+        observed in both frames.
+
+    Notes
+    -----
+    A frame with no observed channel has no nearest neighbour; it takes the
+    previous (filled) frame of its sequence, and the training mean when it
+    is the first frame of its sequence or follows only wholly missing
+    frames.  Only wholly missing frames depend on ``sequence_ids``.  Ties
+    between equally close training frames go to the earliest one.
+
+    References
+    ----------
+    G. W. Taylor, G. E. Hinton and S. Roweis. Modeling Human Motion Using
+    Binary Latent Variables. NIPS 19, 2006, Section 4.4.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn_crbm.impute import NearestNeighborImputer
+    >>> X_train = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 10.0], [2.0, 2.0, 20.0]])
+    >>> X = np.array([[0.9, 1.2, np.nan], [np.nan, 2.1, np.nan]])
+    >>> NearestNeighborImputer().fit(X_train).transform(X)
+    array([[ 0.9,  1.2, 10. ],
+           [ 2. ,  2.1, 20. ]])
+    """
+
+    _parameter_constraints: dict = {"missing_values": [MissingValues()]}
+
+    # Wholly missing frames repeat the previous frame of their own sequence.
+    __metadata_request__transform = {"sequence_ids": True}
+
+    def __init__(self, *, missing_values=np.nan):
+        self.missing_values = missing_values
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X, y=None):
+        """Keep the complete training frames.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            Training frames; those with a missing value are left out.
+        y : None
+            Ignored.
+
+        Returns
+        -------
+        self : NearestNeighborImputer
+            The fitted imputer.
+        """
+        with unfitted_on_error(self):
+            X, mask = check_imputer_input(self, X, reset=True)
+            X = X[complete_runs(mask, None)[0]]
+            if len(X) == 0:
+                raise ValueError(
+                    "NearestNeighborImputer needs complete training frames, but "
+                    "every frame of X has a missing value. Fit on complete data."
+                )
+            self._fit_X = X
+            self._squared_norms = np.einsum("ij,ij->i", X, X)
+            self.mean_ = X.mean(axis=0)
+        return self
+
+    def transform(self, X, *, sequence_ids=None):
+        """Fill every missing value of ``X`` from the nearest training frame.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            Frames with missing values.  Observed values come back unchanged.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+            Used only for wholly missing frames (see Notes).
+
+        Returns
+        -------
+        X_filled : ndarray of shape (n_frames, n_features)
+            ``X`` with no missing value left.
+        """
+        check_is_fitted(self)
+        X, mask = check_imputer_input(self, X, reset=False)
+        sequences = check_sequence_ids(sequence_ids, X.shape[0])
+        empty = mask.all(axis=1)
+        partial = np.flatnonzero(mask.any(axis=1) & ~empty)
+        if len(partial):
+            patterns, which = np.unique(mask[partial], axis=0, return_inverse=True)
+            groups = _split(partial, which.ravel())
+            for pattern, rows in zip(patterns, groups, strict=True):
+                self._fill_pattern(X, rows, pattern)
+        if empty.any():
+            _hold_previous(X, empty, sequences.frame_starts(), self.mean_)
+        return X
+
+    def _fill_pattern(self, X, rows, missing):
+        """Fill ``X[rows]``, which all miss exactly the columns ``missing``."""
+        observed = ~missing
+        train = self._fit_X[:, observed]
+        # ||x - t||^2 = ||x||^2 - 2 x.t + ||t||^2; ||x||^2 does not change argmin.
+        train_norms = self._squared_norms - np.einsum(
+            "ij,ij->i", self._fit_X[:, missing], self._fit_X[:, missing]
+        )
+        step = max(1, _MAX_DISTANCES // len(train))
+        for lo in range(0, len(rows), step):
+            chunk = rows[lo : lo + step]
+            distances = X[np.ix_(chunk, observed)] @ train.T
+            distances *= -2
+            distances += train_norms
+            nearest = np.argmin(distances, axis=1)
+            X[np.ix_(chunk, missing)] = self._fit_X[np.ix_(nearest, missing)]
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
+        return tags
+
+
+def _split(rows, groups):
+    """Split ``rows`` into one array per group label (labels 0 .. k-1)."""
+    order = np.argsort(groups, kind="stable")
+    bounds = np.flatnonzero(np.diff(groups[order])) + 1
+    return np.split(rows[order], bounds)
+
+
+def _hold_previous(X, empty, frame_starts, fallback):
+    """Give each wholly missing frame the last frame before it in its sequence.
+
+    ``X`` must already be filled everywhere else.  A wholly missing frame
+    with no other frame before it in its sequence takes ``fallback``.
+    """
+    index = np.arange(len(X))
+    last_filled = np.maximum.accumulate(np.where(empty, -1, index))
+    source = np.where(last_filled >= frame_starts, last_filled, -1)
+    rows = np.flatnonzero(empty)
+    source = source[rows]
+    has_source = source >= 0
+    X[rows[has_source]] = X[source[has_source]]
+    X[rows[~has_source]] = fallback

@@ -1,0 +1,34 @@
+"""Pictures of motion and of what a model learned (needs matplotlib).
+
+Install matplotlib with the ``plot`` extra: ``pip install sklearn_crbm[plot]``.
+matplotlib is imported only when a function is called.
+
+- :func:`plot_skeleton`: one frame as a stick figure, up axis vertical.
+- :func:`plot_motion_strip`: every few frames side by side (paper Fig. 3).
+- :func:`animate_motion`, :func:`save_animation`, :func:`motion_to_html`:
+  a moving stick figure as a matplotlib animation, a GIF/MP4/HTML file, or
+  an HTML/JavaScript player for notebooks.
+- :func:`plot_hidden_activations`: hidden probabilities over frames
+  (paper Fig. 1).
+- :func:`plot_filled_channels`: filled-in against true channels, with a
+  nearest-neighbour fill (paper Fig. 4).
+"""
+
+from ._figures import plot_filled_channels, plot_hidden_activations
+from ._skeleton import (
+    animate_motion,
+    motion_to_html,
+    plot_motion_strip,
+    plot_skeleton,
+    save_animation,
+)
+
+__all__ = [
+    "animate_motion",
+    "motion_to_html",
+    "plot_filled_channels",
+    "plot_hidden_activations",
+    "plot_motion_strip",
+    "plot_skeleton",
+    "save_animation",
+]

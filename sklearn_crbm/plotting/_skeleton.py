@@ -1,0 +1,594 @@
+"""Skeletons from raw channels: one frame, a strip of frames, an animation."""
+
+from numbers import Integral, Real
+from pathlib import Path
+
+import numpy as np
+
+from ._base import check_matplotlib, get_axes
+
+__all__ = [
+    "animate_motion",
+    "motion_to_html",
+    "plot_motion_strip",
+    "plot_skeleton",
+    "save_animation",
+]
+
+_AXES = "xyz"
+
+
+def _check_frames(data, name="data"):
+    if hasattr(data, "toarray") or hasattr(data, "tocsr"):
+        raise TypeError(
+            f"{name} must be a dense array of raw channels, got a sparse matrix; "
+            "convert it with .toarray()."
+        )
+    frames = np.asarray(data, dtype=np.float64)
+    if frames.ndim == 1:
+        frames = frames[None, :]
+    if frames.ndim != 2 or frames.shape[0] == 0:
+        raise ValueError(
+            f"{name} must be raw channels of shape (n_frames, n_features) or one "
+            f"frame of shape (n_features,), got shape {np.shape(data)}."
+        )
+    if not np.isfinite(frames).all():
+        raise ValueError(f"{name} contains NaN or infinity.")
+    return frames
+
+
+def _positions(skeleton, data, feature_names):
+    """Joint positions (n_frames, n_bones, 3) through the skeleton's kinematics."""
+    if not all(
+        hasattr(skeleton, attribute)
+        for attribute in ("forward_kinematics", "parent_indices", "up_axis")
+    ):
+        raise TypeError(
+            "skeleton must be a sklearn_crbm.datasets.Skeleton (e.g. "
+            f"load_cmu35().skeleton), got {type(skeleton).__name__}."
+        )
+    frames = _check_frames(data)
+    return skeleton.forward_kinematics(frames, feature_names)
+
+
+def _bone_pairs(skeleton):
+    """(child, parent) index of every bone below the root."""
+    parents = np.asarray(skeleton.parent_indices)
+    children = np.flatnonzero(parents >= 0)
+    return children, parents[children]
+
+
+def _height(positions, up):
+    """Extent of the body along the up axis (of its tallest frame)."""
+    extent = positions[..., up].max(axis=1) - positions[..., up].min(axis=1)
+    return float(max(extent.max(), 1e-9))
+
+
+def _hips(skeleton, positions, ground):
+    """The two children of the root farthest apart on the ground plane, or None.
+
+    ``lhipjoint``/``rhipjoint`` in CMU, ``lhip``/``rhip`` in MIT.
+    """
+    parents = np.asarray(skeleton.parent_indices)
+    children = np.flatnonzero(parents == 0)
+    best, pair = 0.0, None
+    frame = positions[0][:, ground]
+    for i in range(len(children)):
+        for j in range(i + 1, len(children)):
+            gap = np.linalg.norm(frame[children[i]] - frame[children[j]])
+            if gap > best:
+                best, pair = gap, (children[i], children[j])
+    return None if best < 1e-9 else pair
+
+
+def _facings(skeleton, positions, up, ground):
+    """Per-frame ground-plane unit vector perpendicular to the hips.
+
+    The sign is kept continuous from frame to frame and chosen so that the
+    body mostly moves along it; without hips the first ground axis is used.
+    """
+    pair = _hips(skeleton, positions, ground)
+    if pair is None:
+        return np.tile([1.0, 0.0], (len(positions), 1))
+    across = positions[:, pair[0], ground] - positions[:, pair[1], ground]
+    across /= np.maximum(np.linalg.norm(across, axis=1, keepdims=True), 1e-12)
+    facing = np.column_stack([-across[:, 1], across[:, 0]])
+    for k in range(1, len(facing)):
+        if facing[k] @ facing[k - 1] < 0:
+            facing[k] = -facing[k]
+    steps = np.diff(positions[:, 0, ground], axis=0)
+    if len(steps) and np.sum(steps * facing[:-1]) < 0:
+        facing = -facing
+    return facing
+
+
+def _facing(skeleton, positions, up, ground):
+    """Ground-plane unit vector perpendicular to the hips in the first frame."""
+    return _facings(skeleton, positions[:1], up, ground)[0]
+
+
+def _horizontal(skeleton, positions, horizontal):
+    """Unit ground-plane direction drawn left to right in a side view."""
+    up = _AXES.index(skeleton.up_axis)
+    ground = [a for a in range(3) if a != up]
+    if horizontal is not None:
+        direction = np.asarray(horizontal, dtype=np.float64)
+        if direction.shape == (3,):
+            direction = direction[ground]
+        if direction.shape != (2,) or not np.linalg.norm(direction) > 0:
+            raise ValueError(
+                "horizontal must be a non-zero direction: 3 world coordinates or 2 "
+                f"ground-plane coordinates, got {horizontal!r}."
+            )
+        return direction / np.linalg.norm(direction), up, ground
+    travel = positions[-1, 0, ground] - positions[0, 0, ground]
+    if np.linalg.norm(travel) > 0.1 * _height(positions, up):
+        return travel / np.linalg.norm(travel), up, ground
+    facing = _facing(skeleton, positions, up, ground)
+    return facing, up, ground
+
+
+def _side_segments(skeleton, positions, horizontal):
+    """2-D segments (n_frames, n_bones - 1, 2, 2) of a side view, and the points."""
+    if isinstance(horizontal, str) and horizontal != "facing":
+        raise ValueError(
+            f"horizontal must be a direction or 'facing', got {horizontal!r}."
+        )
+    if isinstance(horizontal, str):
+        # every frame seen from its own side; figures placed along the path
+        up = _AXES.index(skeleton.up_axis)
+        ground = [a for a in range(3) if a != up]
+        facing = _facings(skeleton, positions, up, ground)
+        root = positions[:, :1, ground]
+        relative = np.einsum("fbg,fg->fb", positions[..., ground] - root, facing)
+        steps = np.einsum("fg,fg->f", np.diff(root[:, 0], axis=0), facing[:-1])
+        across = relative + np.concatenate([[0.0], np.cumsum(steps)])[:, None]
+    else:
+        direction, up, ground = _horizontal(skeleton, positions, horizontal)
+        across = positions[..., ground] @ direction
+    vertical = positions[..., up]
+    points = np.stack([across, vertical], axis=-1)
+    child, parent = _bone_pairs(skeleton)
+    segments = np.stack([points[:, parent], points[:, child]], axis=2)
+    return segments, points
+
+
+def _check_view(view):
+    if view not in ("side", "3d"):
+        raise ValueError(f"view must be 'side' or '3d', got {view!r}.")
+
+
+def plot_skeleton(
+    skeleton,
+    frame,
+    *,
+    feature_names=None,
+    view="side",
+    horizontal=None,
+    ax=None,
+    color="k",
+    linewidth=2.0,
+):
+    """Draw one frame of motion as a stick figure.
+
+    The raw channels go through ``skeleton.forward_kinematics`` and every
+    bone is drawn as a line from its parent's joint to its own, with the
+    skeleton's up axis (``skeleton.up_axis``: y for CMU, z for MIT)
+    vertical.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+        Bones and their channels (e.g. ``load_cmu35().skeleton``).
+    frame : array-like of shape (n_features,)
+        Raw channels of one frame (a ``(1, n_features)`` array works too),
+        e.g. a row of ``load_cmu35().data`` or generated frames after the
+        preprocessing's ``inverse_transform``.
+    feature_names : array-like of str, default=None
+        Name of each channel; default ``skeleton.feature_names``.
+    view : {"side", "3d"}, default="side"
+        ``"side"``: an orthographic side view on the vertical plane through
+        ``horizontal``.  ``"3d"``: matplotlib 3-D axes, up axis vertical.
+    horizontal : array-like of shape (3,) or (2,) or "facing", default=None
+        World (or ground-plane) direction drawn left to right in the side
+        view; default (and ``"facing"``) the direction the body faces
+        (perpendicular to the hips).
+    ax : matplotlib Axes, default=None
+        Where to draw (3-D axes for ``view="3d"``); default a new figure.
+    color : color, default="k"
+        Line colour.
+    linewidth : float, default=2.0
+        Line width.
+
+    Returns
+    -------
+    ax : matplotlib Axes
+        The axes, holding one line collection with a line per bone.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> from sklearn_crbm.plotting import plot_skeleton
+    >>> walker = make_walker(n_sequences=1, n_frames=10, random_state=0)
+    >>> ax = plot_skeleton(walker.skeleton, walker.data[0])
+    >>> len(ax.collections[0].get_segments())  # one line per bone below the root
+    17
+    """
+    check_matplotlib()
+    _check_view(view)
+    positions = _positions(skeleton, frame, feature_names)[:1]
+    if view == "3d":
+        from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+        ax = get_axes(ax, projection="3d")
+        up = _AXES.index(skeleton.up_axis)
+        ground = [a for a in range(3) if a != up]
+        order = [*ground, up]
+        points = positions[0][:, order]
+        child, parent = _bone_pairs(skeleton)
+        ax.add_collection3d(
+            Line3DCollection(
+                np.stack([points[parent], points[child]], axis=1),
+                colors=color,
+                linewidths=linewidth,
+            )
+        )
+        centre = (points.max(axis=0) + points.min(axis=0)) / 2
+        half = (points.max(axis=0) - points.min(axis=0)).max() / 2 * 1.1
+        ax.set_xlim(centre[0] - half, centre[0] + half)
+        ax.set_ylim(centre[1] - half, centre[1] + half)
+        ax.set_zlim(centre[2] - half, centre[2] + half)
+        ax.set_box_aspect((1, 1, 1))
+        ax.set_xlabel(_AXES[ground[0]])
+        ax.set_ylabel(_AXES[ground[1]])
+        ax.set_zlabel(f"{_AXES[up]} (up)")
+        return ax
+    from matplotlib.collections import LineCollection
+
+    ax = get_axes(ax)
+    segments, points = _side_segments(skeleton, positions, horizontal)
+    ax.add_collection(LineCollection(segments[0], colors=color, linewidths=linewidth))
+    _frame_limits(ax, points.reshape(-1, 2))
+    return ax
+
+
+def _frame_limits(ax, points, margin=0.1):
+    low, high = points.min(axis=0), points.max(axis=0)
+    pad = margin * max(float((high - low).max()), 1e-9)
+    ax.set_xlim(low[0] - pad, high[0] + pad)
+    ax.set_ylim(low[1] - pad, high[1] + pad)
+    ax.set_aspect("equal")
+
+
+def plot_motion_strip(
+    skeleton,
+    data,
+    *,
+    feature_names=None,
+    step=4,
+    spacing="auto",
+    horizontal=None,
+    ax=None,
+    color="k",
+    linewidth=1.5,
+    ground=True,
+):
+    """Draw every ``step``-th frame side by side, like Fig. 3 of the paper.
+
+    Each drawn frame is a stick figure at its place in the world, seen from
+    the side with the up axis vertical, so a walk moves from left to right;
+    ``spacing`` adds room between figures that would otherwise overlap.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+        Bones and their channels.
+    data : array-like of shape (n_frames, n_features)
+        Raw channels of one sequence, in time order (e.g. one trial of
+        ``load_cmu35().data``, or generated frames after the preprocessing's
+        ``inverse_transform``).
+    feature_names : array-like of str, default=None
+        Name of each channel; default ``skeleton.feature_names``.
+    step : int, default=4
+        Draw frames ``0, step, 2 * step, ...`` (the paper: 4 frames apart).
+    spacing : "auto" or float, default="auto"
+        Extra distance added between consecutive figures along the
+        horizontal axis.  ``"auto"`` spreads them by at least 0.4 body
+        heights each (a walk advances far less than a body width in 4
+        frames); ``0`` draws them where they are.
+    horizontal : array-like of shape (3,) or (2,) or "facing", default=None
+        World (or ground-plane) direction drawn left to right; default the
+        direction the root travels over the sequence (the way the body faces
+        when it hardly travels).  ``"facing"`` draws every frame from its
+        own side (perpendicular to its hips) and places the figures along
+        the path walked, for motion that turns.
+    ax : matplotlib Axes, default=None
+        Where to draw; default a new wide figure.
+    color : color or list of colors, default="k"
+        Colour of all figures, or one per figure.
+    linewidth : float, default=1.5
+        Line width.
+    ground : bool, default=True
+        Draw a thin ground line under the figures.
+
+    Returns
+    -------
+    ax : matplotlib Axes
+        The axes, with one line collection per drawn frame.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> from sklearn_crbm.plotting import plot_motion_strip
+    >>> walker = make_walker(n_sequences=1, n_frames=40, random_state=0)
+    >>> ax = plot_motion_strip(walker.skeleton, walker.data, step=4)
+    >>> len(ax.collections)  # 40 frames, every 4th drawn
+    10
+    """
+    check_matplotlib()
+    from matplotlib.collections import LineCollection
+
+    if isinstance(step, bool) or not isinstance(step, Integral) or step < 1:
+        raise ValueError(f"step must be a positive integer, got {step!r}.")
+    if not (
+        (isinstance(spacing, str) and spacing == "auto")
+        or (
+            isinstance(spacing, Real) and not isinstance(spacing, bool) and spacing >= 0
+        )
+    ):
+        raise ValueError(f"spacing must be 'auto' or a number >= 0, got {spacing!r}.")
+    positions = _positions(skeleton, data, feature_names)
+    segments, points = _side_segments(skeleton, positions, horizontal)
+    drawn = np.arange(0, len(positions), step)
+    segments, points = segments[drawn], points[drawn]
+    if spacing == "auto":
+        up = _AXES.index(skeleton.up_axis)
+        height = _height(positions, up)
+        advance = 0.0
+        if len(drawn) > 1:
+            advance = (points[-1, 0, 0] - points[0, 0, 0]) / (len(drawn) - 1)
+        spacing = max(0.0, 0.4 * height - advance)
+    shift = np.zeros(2)
+    if ax is None:
+        plt = check_matplotlib()
+        _, ax = plt.subplots(figsize=(min(2 + 0.6 * len(drawn), 20), 3))
+    colors = color if isinstance(color, list | tuple) else [color] * len(drawn)
+    if len(colors) != len(drawn):
+        raise ValueError(f"color has {len(colors)} entries for {len(drawn)} figures.")
+    for k in range(len(drawn)):
+        shift[0] = k * spacing
+        segments[k] += shift
+        points[k] += shift
+        ax.add_collection(
+            LineCollection(segments[k], colors=colors[k], linewidths=linewidth)
+        )
+    flat = points.reshape(-1, 2)
+    _frame_limits(ax, flat, margin=0.05)
+    if ground:
+        ax.axhline(flat[:, 1].min(), color="0.6", linewidth=0.8, zorder=0)
+    ax.set_xticks([])
+    ax.set_yticks([])
+    return ax
+
+
+def animate_motion(
+    skeleton,
+    data,
+    *,
+    feature_names=None,
+    frame_rate=30.0,
+    follow=True,
+    horizontal=None,
+    ax=None,
+    color="k",
+    linewidth=2.0,
+    title=None,
+):
+    """Animate a sequence as a moving stick figure (side view, up axis vertical).
+
+    Save it with :func:`save_animation` (GIF through Pillow, MP4 through
+    ffmpeg) or show it in a notebook with :func:`motion_to_html`.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+        Bones and their channels.
+    data : array-like of shape (n_frames, n_features)
+        Raw channels of one sequence, in time order.
+    feature_names : array-like of str, default=None
+        Name of each channel; default ``skeleton.feature_names``.
+    frame_rate : float, default=30.0
+        Frames per second of playback.
+    follow : bool, default=True
+        Keep the figure centred by moving the view with the root; otherwise
+        the view covers the whole path.
+    horizontal : array-like of shape (3,) or (2,) or "facing", default=None
+        World (or ground-plane) direction drawn left to right; default the
+        direction the root travels; ``"facing"`` follows the body as it
+        turns (see :func:`plot_motion_strip`).
+    ax : matplotlib Axes, default=None
+        Where to draw; default a new figure.
+    color : color, default="k"
+        Line colour.
+    linewidth : float, default=2.0
+        Line width.
+    title : str, default=None
+        Axes title; ``"{title}  frame {k}"`` is shown while playing.
+
+    Returns
+    -------
+    animation : matplotlib.animation.FuncAnimation
+        One animation frame per data frame.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> from sklearn_crbm.plotting import animate_motion
+    >>> walker = make_walker(n_sequences=1, n_frames=12, random_state=0)
+    >>> animation = animate_motion(walker.skeleton, walker.data)
+    >>> len(list(animation.new_frame_seq()))
+    12
+    >>> html = animation.to_jshtml()  # or save_animation(animation, "walk.gif")
+    """
+    check_matplotlib()
+    from matplotlib.animation import FuncAnimation
+    from matplotlib.collections import LineCollection
+
+    if isinstance(frame_rate, bool) or not isinstance(frame_rate, Real):
+        raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
+    if not frame_rate > 0:
+        raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
+    positions = _positions(skeleton, data, feature_names)
+    segments, points = _side_segments(skeleton, positions, horizontal)
+    up = _AXES.index(skeleton.up_axis)
+    height = _height(positions, up)
+    ax = get_axes(ax)
+    lines = LineCollection(segments[0], colors=color, linewidths=linewidth)
+    ax.add_collection(lines)
+    low = points[..., 1].min() - 0.05 * height
+    high = points[..., 1].max() + 0.05 * height
+    ax.set_ylim(low, high)
+    ax.axhline(points[..., 1].min(), color="0.6", linewidth=0.8, zorder=0)
+    half = 0.75 * (high - low)
+    if not follow:
+        _frame_limits(ax, points.reshape(-1, 2), margin=0.05)
+    else:
+        ax.set_xlim(points[0, 0, 0] - half, points[0, 0, 0] + half)
+        ax.set_aspect("equal")
+    ax.set_xticks([])
+    ax.set_yticks([])
+
+    def update(k):
+        lines.set_segments(segments[k])
+        if follow:
+            ax.set_xlim(points[k, 0, 0] - half, points[k, 0, 0] + half)
+        if title is not None:
+            ax.set_title(f"{title}  frame {k}")
+        return (lines,)
+
+    update(0)
+    return FuncAnimation(
+        ax.figure,
+        update,
+        frames=len(positions),
+        interval=1000.0 / frame_rate,
+        blit=False,
+    )
+
+
+def save_animation(animation, filename, *, frame_rate=30.0, dpi=80):
+    """Write an animation to a GIF (Pillow), an MP4 (ffmpeg) or an HTML file.
+
+    Parameters
+    ----------
+    animation : matplotlib.animation.Animation
+        E.g. from :func:`animate_motion`.
+    filename : path-like
+        ``.gif`` uses matplotlib's ``PillowWriter``; ``.mp4`` its
+        ``FFMpegWriter`` (needs the ``ffmpeg`` program); ``.html`` writes the
+        self-contained JavaScript player of :func:`motion_to_html`.
+    frame_rate : float, default=30.0
+        Frames per second.
+    dpi : int, default=80
+        Resolution of the frames.
+
+    Returns
+    -------
+    filename : pathlib.Path
+        The file written.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import tempfile, pathlib
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> from sklearn_crbm.plotting import animate_motion, save_animation
+    >>> walker = make_walker(n_sequences=1, n_frames=5, random_state=0)
+    >>> animation = animate_motion(walker.skeleton, walker.data)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = save_animation(animation, pathlib.Path(folder) / "walk.gif")
+    ...     path.stat().st_size > 0
+    True
+    """
+    check_matplotlib()
+    from matplotlib import animation as mpl_animation
+
+    path = Path(filename)
+    suffix = path.suffix.lower()
+    if suffix == ".gif":
+        writer = mpl_animation.PillowWriter(fps=frame_rate)
+    elif suffix == ".mp4":
+        if not mpl_animation.FFMpegWriter.isAvailable():
+            raise RuntimeError(
+                "Writing MP4 needs the ffmpeg program, which was not found; save a "
+                "GIF instead (filename ending in .gif)."
+            )
+        writer = mpl_animation.FFMpegWriter(fps=frame_rate)
+    elif suffix in (".html", ".htm"):
+        path.write_text(animation.to_jshtml(fps=frame_rate), encoding="utf-8")
+        return path
+    else:
+        raise ValueError(
+            f"Cannot tell the format of {str(path)!r}: use a name ending in .gif, "
+            ".mp4 or .html."
+        )
+    animation.save(path, writer=writer, dpi=dpi)
+    return path
+
+
+def motion_to_html(skeleton, data, *, feature_names=None, frame_rate=30.0, **kwargs):
+    """A self-contained HTML/JavaScript player of the motion, for notebooks.
+
+    Show it with ``IPython.display.HTML(motion_to_html(...))``.  Unless an
+    ``ax`` is given, the figure used to render the frames is closed
+    afterwards.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+        Bones and their channels.
+    data : array-like of shape (n_frames, n_features)
+        Raw channels of one sequence, in time order.
+    feature_names : array-like of str, default=None
+        Name of each channel; default ``skeleton.feature_names``.
+    frame_rate : float, default=30.0
+        Frames per second of playback.
+    **kwargs
+        Passed to :func:`animate_motion` (``follow``, ``horizontal``, ``ax``,
+        ``color``, ``linewidth``, ``title``).
+
+    Returns
+    -------
+    html : str
+        HTML with the frames embedded as images and a JavaScript player.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> from sklearn_crbm.plotting import motion_to_html
+    >>> walker = make_walker(n_sequences=1, n_frames=4, random_state=0)
+    >>> html = motion_to_html(walker.skeleton, walker.data)
+    >>> "<script" in html
+    True
+    """
+    plt = check_matplotlib()
+    figure = None
+    if kwargs.get("ax") is None:
+        figure, kwargs["ax"] = plt.subplots()
+    animation = animate_motion(
+        skeleton, data, feature_names=feature_names, frame_rate=frame_rate, **kwargs
+    )
+    try:
+        return animation.to_jshtml(fps=frame_rate)
+    finally:
+        if figure is not None:
+            plt.close(figure)
