@@ -107,6 +107,12 @@ VARIANTS = {
     "particles": dict(model=ORIGINAL_MODEL, imputer=dict(n_gibbs=30, n_particles=10)),
     "noisy": dict(model=NOISY_MODEL, imputer=dict(n_gibbs=30, n_particles=1)),
     "robust": dict(model=NOISY_MODEL, imputer=dict(n_gibbs=30, n_particles=10)),
+    # CRBMImputer's default: the noise level that also keeps generated styles
+    # stable (generation_styles.py)
+    "noisy0.8": dict(
+        model=dict(ORIGINAL_MODEL, history_noise=0.8),
+        imputer=dict(n_gibbs=30, n_particles=1),
+    ),
 }
 
 

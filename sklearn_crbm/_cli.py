@@ -90,8 +90,9 @@ def _parser():
     demo.add_argument(
         "--n-particles",
         type=int,
-        default=20,
-        help="weighted particles per fill-in chain (1: the original scheme)",
+        default=1,
+        help="weighted particles per fill-in chain (default: %(default)s, the "
+        "original scheme)",
     )
     demo.add_argument(
         "--n-frames",
@@ -159,6 +160,14 @@ def _add_model_options(parser, n_iter):
     parser.add_argument("--n-components", type=int, default=200)
     parser.add_argument("--order", type=int, default=3)
     parser.add_argument(
+        "--history-noise",
+        type=float,
+        default=0.8,
+        help="noise on the history during training (default: %(default)s; 0 is "
+        "the paper's schedule, whose fill-ins and generated styles drift for "
+        "some seeds)",
+    )
+    parser.add_argument(
         "--n-iter",
         type=int,
         default=n_iter,
@@ -204,6 +213,7 @@ def run_demo(args):
         args.n_components,
         order=args.order,
         n_iter=args.n_iter,
+        history_noise=args.history_noise,
         random_state=args.seed,
         verbose=max(1, args.n_iter // 10),
     )
@@ -423,6 +433,7 @@ def run_fit(args):
                     args.n_components,
                     order=args.order,
                     n_iter=args.n_iter,
+                    history_noise=args.history_noise,
                     random_state=args.seed,
                     verbose=max(1, args.n_iter // 10),
                 ),
