@@ -5,3 +5,9 @@ import os
 # scikit-learn's check_array_api_input runs only when SciPy's array API
 # support is switched on, which must happen before SciPy is first imported.
 os.environ.setdefault("SCIPY_ARRAY_API", "1")
+
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+# The test models are small: one BLAS thread is as fast, and on a loaded
+# 2-core machine several threads per product are many times slower.
+_BLAS_LIMITS = threadpool_limits(1)

@@ -10,8 +10,10 @@ import sys
 import time
 from pathlib import Path
 
+import joblib
 import numpy as np
 import sklearn
+from sklearn.pipeline import Pipeline
 
 from ._crbm import ConditionalRBM
 from .datasets import (
@@ -53,7 +55,7 @@ def main(argv=None):
     try:
         with sklearn.config_context(enable_metadata_routing=True):
             return args.run(args)
-    except FileNotFoundError as exc:
+    except (OSError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
 
@@ -420,9 +422,6 @@ def run_fetch(args):
 
 
 def run_fit(args):
-    import joblib
-    from sklearn.pipeline import Pipeline
-
     train = _load_cmu35(args.data_home, "train")
     pipeline = Pipeline(
         make_motion_preprocessor(train.skeleton).steps
@@ -446,10 +445,27 @@ def run_fit(args):
     return 0
 
 
-def run_sample(args):
-    import joblib
+def _load_model(path):
+    """The pipeline written by ``fit``; a clear error for anything else."""
+    try:
+        model = joblib.load(path)
+    except FileNotFoundError:
+        raise
+    except Exception as exc:  # joblib/pickle raise many types on foreign files
+        raise ValueError(
+            f"{path} is not a model saved by 'python -m sklearn_crbm fit' "
+            f"({type(exc).__name__}: {exc})."
+        ) from None
+    if not isinstance(model, Pipeline) or not isinstance(model[-1], ConditionalRBM):
+        raise ValueError(
+            f"{path} holds a {type(model).__name__}, not the pipeline (motion "
+            "preprocessor + ConditionalRBM) that 'python -m sklearn_crbm fit' saves."
+        )
+    return model
 
-    pipeline = joblib.load(args.model)
+
+def run_sample(args):
+    pipeline = _load_model(args.model)
     crbm, preprocessor = pipeline[-1], pipeline[:-1]
     train = _load_cmu35(args.data_home, "train")
     Z = preprocessor.transform(train.data, sequence_ids=train.sequence_ids)

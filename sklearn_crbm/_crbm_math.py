@@ -38,10 +38,11 @@ def logistic(activation, out=None):
     The same formula as :func:`scipy.special.expit`, built from numpy's
     vectorised ``exp`` (several times faster than ``expit`` on the arrays of a
     minibatch); ``out`` may be ``activation`` itself.  Very negative inputs
-    overflow ``exp`` to ``inf`` and give exactly 0, without a warning.
+    overflow ``exp`` to ``inf`` and give exactly 0, very positive ones
+    underflow it to 0 and give exactly 1, without a warning.
     """
     out = np.negative(activation, out=out)
-    with np.errstate(over="ignore"):
+    with np.errstate(over="ignore", under="ignore"):
         np.exp(out, out=out)
     out += 1
     return np.reciprocal(out, out=out)
@@ -267,7 +268,7 @@ def sample_hidden_states(
     an input.  With ``negated=True`` ``hidden_bias`` holds ``-b_hat`` (a
     caller that uses one bias for many steps negates it once).
     """
-    with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         return _sample_hidden_states(
             params, visible, hidden_bias, rng, out, work, negated
         )
@@ -307,7 +308,8 @@ def free_energy(params, visible, visible_bias, hidden_bias):
     """
     activation = visible @ params.weights.T
     activation += hidden_bias
-    softplus = np.logaddexp(0, activation).sum(axis=1)
+    with np.errstate(under="ignore"):  # softplus(-1e4) = 0 exactly enough
+        softplus = np.logaddexp(0, activation).sum(axis=1)
     if params.visible_type == GAUSSIAN:
         quadratic = 0.5 * np.square(visible - visible_bias).sum(axis=1)
     else:
@@ -514,7 +516,7 @@ def gibbs_frames(
     work = np.empty_like(negative_bias)
     noisy_bias = np.empty_like(negative_bias) if hidden_noise else None
     drawn = np.empty_like(visible) if sample_visibles else None
-    with np.errstate(over="ignore", invalid="ignore"):
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         for _ in range(n_gibbs):
             bias = negative_bias
             if hidden_noise:  # -(b_hat + noise * z), the draws as before
