@@ -30,6 +30,7 @@ from ._crbm_math import (
     mean_field_prediction,
 )
 from .utils._fitting import unfitted_on_error
+from .utils._persistence import VersionedPickleMixin
 from .utils._sequences import (
     balanced_batches,
     check_sequence_ids,
@@ -58,7 +59,12 @@ def _rng_from(random_state):
     return np.random.default_rng(seed)
 
 
-class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEstimator):
+class ConditionalRBM(
+    VersionedPickleMixin,
+    ClassNamePrefixFeaturesOutMixin,
+    TransformerMixin,
+    BaseEstimator,
+):
     """Conditional Restricted Boltzmann Machine for sequences of frames.
 
     Models each frame ``v_t`` with visible units (Gaussian with unit variance
@@ -730,49 +736,20 @@ class ConditionalRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEsti
                 f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
             )
         rng = _rng_from(self.random_state if random_state is None else random_state)
-        seed = self._seed_frames(history, n_sequences, rng)
+        seed = seed_frames(
+            history,
+            n_sequences,
+            width=max(self._n_lags, 1),
+            n_features=self.n_features_in_,
+            dtype=self.components_.dtype,
+            seed_windows=self.seed_windows_,
+            rng=rng,
+        )
         params = self._params()
         frames = self._generate(
             params, seed, n_samples, n_gibbs, hidden_noise, sample_visibles, rng
         )
         return frames.reshape(-1, self.n_features_in_)
-
-    def _seed_frames(self, history, n_sequences, rng):
-        """Seed windows of shape (n_sequences, width, n_features), oldest first."""
-        width = max(self._n_lags, 1)
-        dtype = self.components_.dtype
-        if history is None:
-            picks = rng.integers(len(self.seed_windows_), size=n_sequences)
-            return self.seed_windows_[picks]
-        if hasattr(history, "toarray") or hasattr(history, "tocsr"):
-            raise TypeError("history must be a dense array, got a sparse matrix.")
-        try:
-            history = np.asarray(history, dtype=dtype)
-        except (TypeError, ValueError) as exc:
-            raise TypeError(
-                f"history must be an array of numbers, got {type(history).__name__}."
-            ) from exc
-        if history.ndim == 2:
-            history = np.broadcast_to(history, (n_sequences, *history.shape))
-        elif history.ndim == 3:
-            if n_sequences not in (1, history.shape[0]):
-                raise ValueError(
-                    f"history holds {history.shape[0]} seeds but n_sequences="
-                    f"{n_sequences}; give one seed per sequence or a 2-D history."
-                )
-        else:
-            raise ValueError(
-                "history must have shape (n_frames, n_features) or (n_sequences, "
-                f"n_frames, n_features), got shape {history.shape}."
-            )
-        if history.shape[2] != self.n_features_in_ or history.shape[1] < width:
-            raise ValueError(
-                f"history must hold at least {width} frames of "
-                f"{self.n_features_in_} features each, got shape {history.shape}."
-            )
-        if not np.isfinite(history).all():
-            raise ValueError("history contains NaN or infinity.")
-        return np.ascontiguousarray(history[:, -width:])
 
     def _generate(
         self, params, seed, n_samples, n_gibbs, hidden_noise, sample_visibles, rng
@@ -820,6 +797,47 @@ def _c_ordered(params):
     params.weights = np.ascontiguousarray(params.weights)
     params.dynamic = np.ascontiguousarray(params.dynamic)
     return params
+
+
+def seed_frames(history, n_sequences, *, width, n_features, dtype, seed_windows, rng):
+    """Check a ``sample`` history; seeds of shape (n_sequences, width, n_features).
+
+    ``None`` draws windows of real training frames from ``seed_windows``; a
+    2-D history seeds every sequence with its last ``width`` rows; a 3-D one
+    gives one seed per sequence.  Oldest frame first.
+    """
+    if history is None:
+        picks = rng.integers(len(seed_windows), size=n_sequences)
+        return seed_windows[picks]
+    if hasattr(history, "toarray") or hasattr(history, "tocsr"):
+        raise TypeError("history must be a dense array, got a sparse matrix.")
+    try:
+        history = np.asarray(history, dtype=dtype)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(
+            f"history must be an array of numbers, got {type(history).__name__}."
+        ) from exc
+    if history.ndim == 2:
+        history = np.broadcast_to(history, (n_sequences, *history.shape))
+    elif history.ndim == 3:
+        if n_sequences not in (1, history.shape[0]):
+            raise ValueError(
+                f"history holds {history.shape[0]} seeds but n_sequences="
+                f"{n_sequences}; give one seed per sequence or a 2-D history."
+            )
+    else:
+        raise ValueError(
+            "history must have shape (n_frames, n_features) or (n_sequences, "
+            f"n_frames, n_features), got shape {history.shape}."
+        )
+    if history.shape[2] != n_features or history.shape[1] < width:
+        raise ValueError(
+            f"history must hold at least {width} frames of {n_features} features "
+            f"each, got shape {history.shape}."
+        )
+    if not np.isfinite(history).all():
+        raise ValueError("history contains NaN or infinity.")
+    return np.ascontiguousarray(history[:, -width:])
 
 
 def _evenly_spaced(values, at_most):

@@ -17,13 +17,20 @@ from sklearn.utils.validation import (
     validate_data,
 )
 
-from ._crbm import ConditionalRBM, _check_count, _evenly_spaced, _rng_from
+from ._crbm import (
+    ConditionalRBM,
+    _check_count,
+    _evenly_spaced,
+    _rng_from,
+    seed_frames,
+)
 from ._crbm_math import (
     CRBMParameters,
     dynamic_biases,
     mean_field_prediction,
     visible_means,
 )
+from .utils._persistence import VersionedPickleMixin
 from .utils._sequences import check_sequence_ids, frame_history
 
 __all__ = ["StackedCRBM"]
@@ -47,7 +54,12 @@ def _layer_params(layer, dtype=None):
     )
 
 
-class StackedCRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEstimator):
+class StackedCRBM(
+    VersionedPickleMixin,
+    ClassNamePrefixFeaturesOutMixin,
+    TransformerMixin,
+    BaseEstimator,
+):
     """Deep stack of conditional RBMs trained greedily, layer by layer.
 
     The first layer is a :class:`ConditionalRBM` with Gaussian visible units
@@ -622,7 +634,15 @@ class StackedCRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEstimat
                 f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
             )
         rng = _rng_from(self.random_state if random_state is None else random_state)
-        seed = self._seed_frames(history, n_sequences, rng)
+        seed = seed_frames(
+            history,
+            n_sequences,
+            width=max(self.history_length, 1),
+            n_features=self.n_features_in_,
+            dtype=self.layers_[0].components_.dtype,
+            seed_windows=self.seed_windows_,
+            rng=rng,
+        )
         n_sequences, width, n_features = seed.shape
 
         # Pass the seed up: level k holds the frames of layer k's visibles
@@ -671,44 +691,6 @@ class StackedCRBM(ClassNamePrefixFeaturesOutMixin, TransformerMixin, BaseEstimat
             visible_bias, _ = dynamic_biases(params, history)
             frames[:, n_lags + t] = visible_means(params, hidden[:, t], visible_bias)
         return frames[:, n_lags:]
-
-    def _seed_frames(self, history, n_sequences, rng):
-        """Seed windows of shape (n_sequences, history_length, n_features)."""
-        width = max(self.history_length, 1)
-        dtype = self.layers_[0].components_.dtype
-        if history is None:
-            picks = rng.integers(len(self.seed_windows_), size=n_sequences)
-            return self.seed_windows_[picks]
-        if hasattr(history, "toarray") or hasattr(history, "tocsr"):
-            raise TypeError("history must be a dense array, got a sparse matrix.")
-        try:
-            history = np.asarray(history, dtype=dtype)
-        except (TypeError, ValueError) as exc:
-            raise TypeError(
-                f"history must be an array of numbers, got {type(history).__name__}."
-            ) from exc
-        if history.ndim == 2:
-            history = np.broadcast_to(history, (n_sequences, *history.shape))
-        elif history.ndim == 3:
-            if n_sequences not in (1, history.shape[0]):
-                raise ValueError(
-                    f"history holds {history.shape[0]} seeds but n_sequences="
-                    f"{n_sequences}; give one seed per sequence or a 2-D history."
-                )
-        else:
-            raise ValueError(
-                "history must have shape (n_frames, n_features) or (n_sequences, "
-                f"n_frames, n_features), got shape {history.shape}."
-            )
-        if history.shape[2] != self.n_features_in_ or history.shape[1] < width:
-            raise ValueError(
-                f"history must hold at least {width} frames (the stack's "
-                f"history_length) of {self.n_features_in_} features each, got "
-                f"shape {history.shape}."
-            )
-        if not np.isfinite(history).all():
-            raise ValueError("history contains NaN or infinity.")
-        return np.ascontiguousarray(history[:, -width:])
 
     # ---------------------------------------------------------------- misc
 

@@ -13,6 +13,7 @@ from sklearn.base import (
 from sklearn.utils import check_random_state
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import HasMethods, Interval, MissingValues
+from sklearn.utils.parallel import Parallel, delayed
 from sklearn.utils.validation import check_is_fitted
 
 from .._crbm import ConditionalRBM
@@ -24,7 +25,8 @@ from .._crbm_math import (
     stacked_prediction,
 )
 from ..utils._fitting import unfitted_on_error
-from ..utils._sequences import check_sequence_ids
+from ..utils._persistence import VersionedPickleMixin
+from ..utils._sequences import Sequences, check_sequence_ids
 from ._base import check_imputer_input, complete_runs
 
 # Rounds of "fill, then use the fill as its own past" for the first frame of a
@@ -32,6 +34,10 @@ from ._base import check_imputer_input, complete_runs
 _FIRST_FRAME_ROUNDS = 3
 # Mean-field iterations of the one-step prediction that weights particles.
 _PREDICTION_STEPS = 10
+# At most this many sequences are filled together, as one block; blocks get
+# their own random streams and run in parallel with ``n_jobs``.  The split
+# depends on the data only, so the fills do not depend on ``n_jobs``.
+_BLOCK_SEQUENCES = 32
 # history_noise of the default model: removes the drift of on-line fill-in on
 # CMU 35 (benchmarks/paper_fillin.py, 5 training seeds; 0.4 does too) and keeps
 # generated styles stable (benchmarks/generation_styles.py, where 0.4 does not).
@@ -51,7 +57,9 @@ def _layers(estimator):
     return [estimator]
 
 
-class CRBMImputer(OneToOneFeatureMixin, TransformerMixin, BaseEstimator):
+class CRBMImputer(
+    VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
+):
     """Fill missing channels on-line with a conditional RBM (paper §4.4).
 
     ``fit`` trains a clone of ``estimator`` on complete sequences.
@@ -94,6 +102,14 @@ class CRBMImputer(OneToOneFeatureMixin, TransformerMixin, BaseEstimator):
         Seeds the Gibbs sampling of :meth:`transform`; pass an int for
         reproducible fills.  The estimator keeps its own ``random_state``
         for training.
+    n_jobs : int, default=None
+        Number of jobs filling blocks of sequences in parallel (joblib).
+        Up to 32 sequences are filled together, vectorised, as one block;
+        more are split into near-equal blocks of consecutive sequences,
+        each with its own random stream drawn from ``random_state``.  The
+        split depends on the data only, so the fills are the same for every
+        ``n_jobs``.  ``None`` means 1 unless in a
+        :func:`joblib.parallel_backend` context; ``-1`` means all processors.
 
     Attributes
     ----------
@@ -197,6 +213,7 @@ class CRBMImputer(OneToOneFeatureMixin, TransformerMixin, BaseEstimator):
         "n_particles": [Interval(Integral, 1, None, closed="left")],
         "missing_values": [MissingValues()],
         "random_state": ["random_state"],
+        "n_jobs": [None, Integral],
     }
 
     # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
@@ -213,6 +230,7 @@ class CRBMImputer(OneToOneFeatureMixin, TransformerMixin, BaseEstimator):
         n_particles=1,
         missing_values=np.nan,
         random_state=None,
+        n_jobs=None,
     ):
         self.estimator = estimator
         self.n_gibbs = n_gibbs
@@ -220,6 +238,7 @@ class CRBMImputer(OneToOneFeatureMixin, TransformerMixin, BaseEstimator):
         self.n_particles = n_particles
         self.missing_values = missing_values
         self.random_state = random_state
+        self.n_jobs = n_jobs
 
     @_fit_context(prefer_skip_nested_validation=False)
     def fit(self, X, y=None, *, sequence_ids=None):
@@ -333,13 +352,50 @@ class CRBMImputer(OneToOneFeatureMixin, TransformerMixin, BaseEstimator):
             return X if average else np.broadcast_to(X, (n_draws, *X.shape)).copy()
         rng = _rng_from(random_state)
         layers = [layer._params() for layer in _layers(self.estimator_)]
-        draws = self._fill(layers, X, mask, sequences, n_draws, rng)
+        draws = self._fill_blocks(layers, X, mask, sequences, n_draws, rng)
         if average:
             X[mask] = draws.mean(axis=0)[mask]
             return X
         out = np.broadcast_to(X, draws.shape).copy()
         out[:, mask] = draws[:, mask]
         return out
+
+    def _fill_blocks(self, layers, X, mask, sequences, n_draws, rng):
+        """:meth:`_fill` on blocks of whole sequences, in parallel with ``n_jobs``.
+
+        Up to ``_BLOCK_SEQUENCES`` sequences form a single block, filled with
+        ``rng`` itself.  More are split into near-equal blocks of consecutive
+        sequences, each filled with its own generator seeded from ``rng``;
+        the blocks and their seeds depend on the data only, so ``n_jobs``
+        never changes the fills.
+        """
+        n_blocks = -(-sequences.n_sequences // _BLOCK_SEQUENCES)
+        if n_blocks <= 1:
+            return self._fill(layers, X, mask, sequences, n_draws, rng)
+        seeds = rng.integers(np.iinfo(np.int64).max, size=n_blocks)
+        jobs = []
+        for block, seed in zip(
+            np.array_split(np.arange(sequences.n_sequences), n_blocks),
+            seeds,
+            strict=True,
+        ):
+            lo, hi = sequences.starts[block[0]], sequences.stops[block[-1]]
+            block_sequences = Sequences(
+                starts=sequences.starts[block] - lo,
+                lengths=sequences.lengths[block],
+                ids=sequences.ids[block],
+            )
+            jobs.append(
+                delayed(self._fill)(
+                    layers,
+                    X[lo:hi],
+                    mask[lo:hi],
+                    block_sequences,
+                    n_draws,
+                    np.random.default_rng(seed),
+                )
+            )
+        return np.concatenate(Parallel(n_jobs=self.n_jobs)(jobs), axis=1)
 
     def _fill(self, layers, X, mask, sequences, n_draws, rng):
         """``n_draws`` on-line fills, all sequences and draws advancing together.

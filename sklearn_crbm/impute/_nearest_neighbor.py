@@ -12,6 +12,7 @@ from sklearn.utils._param_validation import MissingValues
 from sklearn.utils.validation import check_is_fitted
 
 from ..utils._fitting import unfitted_on_error
+from ..utils._persistence import VersionedPickleMixin
 from ..utils._sequences import check_sequence_ids
 from ._base import check_imputer_input, complete_runs
 
@@ -19,7 +20,9 @@ from ._base import check_imputer_input, complete_runs
 _MAX_DISTANCES = 1 << 22
 
 
-class NearestNeighborImputer(OneToOneFeatureMixin, TransformerMixin, BaseEstimator):
+class NearestNeighborImputer(
+    VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
+):
     """Fill missing channels from the nearest training frame (paper §4.4 baseline).
 
     For each frame, the Euclidean distance over that frame's observed

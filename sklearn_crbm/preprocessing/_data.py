@@ -14,10 +14,12 @@ from sklearn.utils.validation import (
     validate_data,
 )
 
+from ..utils._persistence import VersionedPickleMixin
+
 __all__ = ["StandardScaler"]
 
 
-class StandardScaler(TransformerMixin, BaseEstimator):
+class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
     """Standardise features and drop the constant ones.
 
     Like :class:`sklearn.preprocessing.StandardScaler` (``z = (x - u) / s``

@@ -11,6 +11,7 @@ from sklearn.utils.validation import (
     validate_data,
 )
 
+from ..utils._persistence import VersionedPickleMixin
 from ..utils._rotations import (
     euler_to_matrix,
     expmap_to_matrix,
@@ -29,7 +30,7 @@ from ._layout import (
 __all__ = ["ExpMapEncoder"]
 
 
-class ExpMapEncoder(TransformerMixin, BaseEstimator):
+class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
     """Encode each bone's Euler angles as an exponential map.
 
     Every bone with Euler-angle channels (``rx``, ``ry``, ``rz``; one, two or

@@ -9,6 +9,7 @@ from sklearn.utils.validation import (
     validate_data,
 )
 
+from ..utils._persistence import VersionedPickleMixin
 from ..utils._rotations import expmap_to_matrix, matrix_to_expmap
 from ..utils._sequences import check_sequence_ids
 from ._layout import check_encoded, expmap_feature_names
@@ -25,7 +26,7 @@ def _wrap(angle):
     return (angle + np.pi) % (2.0 * np.pi) - np.pi
 
 
-class RootRelativeEncoder(TransformerMixin, BaseEstimator):
+class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
     """Make the root invariant to ground-plane translation and heading.
 
     The root's global position (``root_tx``, ``root_ty``, ``root_tz``) and
