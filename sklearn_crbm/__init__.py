@@ -6,7 +6,7 @@ conditional RBM and its two-level stack, the paper's motion-capture
 preprocessing, on-line filling in of missing channels, and generation.
 """
 
-from . import datasets, metrics, plotting, preprocessing
+from . import datasets, metrics, model_selection, plotting, preprocessing
 from ._crbm import ConditionalRBM, TrainingDivergedError
 from ._stacked import StackedCRBM
 from .impute import CRBMImputer, NearestNeighborImputer
@@ -32,6 +32,7 @@ __all__ = [
     "datasets",
     "make_motion_preprocessor",
     "metrics",
+    "model_selection",
     "plotting",
     "preprocessing",
 ]

@@ -30,6 +30,7 @@ from ._crbm_math import (
     mean_field_prediction,
 )
 from .utils._fitting import unfitted_on_error
+from .utils._parallel import map_sequence_blocks
 from .utils._persistence import VersionedPickleMixin
 from .utils._sequences import (
     balanced_batches,
@@ -681,6 +682,7 @@ class ConditionalRBM(
         hidden_noise=0.0,
         sample_visibles=False,
         random_state=None,
+        n_jobs=None,
     ):
         """Generate new frames by alternating Gibbs sampling (paper §4).
 
@@ -719,6 +721,13 @@ class ConditionalRBM(
             Seeds the generation; ``None`` uses the estimator's
             ``random_state``, so repeated calls give the same frames when
             that is an int.
+        n_jobs : int, default=None
+            Number of jobs generating blocks of 32 sequences in parallel
+            (joblib; ``None`` means 1 unless in a
+            :obj:`joblib.parallel_backend` context).  Up to 32 sequences are
+            generated together in one vectorised pass; the blocks and their
+            random streams depend on ``n_sequences`` only, so the frames are
+            the same for any ``n_jobs``.
 
         Returns
         -------
@@ -746,10 +755,20 @@ class ConditionalRBM(
             rng=rng,
         )
         params = self._params()
-        frames = self._generate(
-            params, seed, n_samples, n_gibbs, hidden_noise, sample_visibles, rng
-        )
-        return frames.reshape(-1, self.n_features_in_)
+
+        def generate_block(block, block_rng):
+            return self._generate(
+                params,
+                seed[block],
+                n_samples,
+                n_gibbs,
+                hidden_noise,
+                sample_visibles,
+                block_rng,
+            )
+
+        blocks = map_sequence_blocks(generate_block, len(seed), rng, n_jobs)
+        return np.concatenate(blocks).reshape(-1, self.n_features_in_)
 
     def _generate(
         self, params, seed, n_samples, n_gibbs, hidden_noise, sample_visibles, rng

@@ -608,3 +608,19 @@ def test_bad_input_gets_clear_errors():
         model.transform(X[:, :3])
     with pytest.raises(ValueError, match="NaN"):
         model.sample(3, history=np.full((3, 5), np.nan))
+
+
+def test_sample_n_jobs_gives_the_same_frames():
+    X, ids = oscillations()
+    model = ConditionalRBM(6, order=2, n_iter=2, random_state=0).fit(
+        X, sequence_ids=ids
+    )
+    serial = model.sample(5, n_sequences=70, random_state=3)
+    parallel = model.sample(5, n_sequences=70, random_state=3, n_jobs=2)
+    assert serial.shape == (350, 5)
+    assert_array_equal(serial, parallel)
+    # up to 32 sequences are one vectorised block, which n_jobs leaves alone
+    assert_array_equal(
+        model.sample(5, n_sequences=3, random_state=3),
+        model.sample(5, n_sequences=3, random_state=3, n_jobs=2),
+    )

@@ -13,7 +13,6 @@ from sklearn.base import (
 from sklearn.utils import check_random_state
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import HasMethods, Interval, MissingValues
-from sklearn.utils.parallel import Parallel, delayed
 from sklearn.utils.validation import check_is_fitted
 
 from .._crbm import ConditionalRBM
@@ -25,6 +24,7 @@ from .._crbm_math import (
     stacked_prediction,
 )
 from ..utils._fitting import unfitted_on_error
+from ..utils._parallel import map_sequence_blocks
 from ..utils._persistence import VersionedPickleMixin
 from ..utils._sequences import Sequences, check_sequence_ids
 from ._base import check_imputer_input, complete_runs
@@ -34,10 +34,6 @@ from ._base import check_imputer_input, complete_runs
 _FIRST_FRAME_ROUNDS = 3
 # Mean-field iterations of the one-step prediction that weights particles.
 _PREDICTION_STEPS = 10
-# At most this many sequences are filled together, as one block; blocks get
-# their own random streams and run in parallel with ``n_jobs``.  The split
-# depends on the data only, so the fills do not depend on ``n_jobs``.
-_BLOCK_SEQUENCES = 32
 # history_noise of the default model: removes the drift of on-line fill-in on
 # CMU 35 (benchmarks/paper_fillin.py, 5 training seeds; 0.4 does too) and keeps
 # generated styles stable (benchmarks/generation_styles.py, where 0.4 does not).
@@ -363,39 +359,26 @@ class CRBMImputer(
     def _fill_blocks(self, layers, X, mask, sequences, n_draws, rng):
         """:meth:`_fill` on blocks of whole sequences, in parallel with ``n_jobs``.
 
-        Up to ``_BLOCK_SEQUENCES`` sequences form a single block, filled with
-        ``rng`` itself.  More are split into near-equal blocks of consecutive
-        sequences, each filled with its own generator seeded from ``rng``;
-        the blocks and their seeds depend on the data only, so ``n_jobs``
-        never changes the fills.
+        The blocks and their random streams depend on the data only
+        (:func:`~sklearn_crbm.utils._parallel.map_sequence_blocks`), so
+        ``n_jobs`` never changes the fills.
         """
-        n_blocks = -(-sequences.n_sequences // _BLOCK_SEQUENCES)
-        if n_blocks <= 1:
-            return self._fill(layers, X, mask, sequences, n_draws, rng)
-        seeds = rng.integers(np.iinfo(np.int64).max, size=n_blocks)
-        jobs = []
-        for block, seed in zip(
-            np.array_split(np.arange(sequences.n_sequences), n_blocks),
-            seeds,
-            strict=True,
-        ):
+
+        def fill_block(block, block_rng):
             lo, hi = sequences.starts[block[0]], sequences.stops[block[-1]]
             block_sequences = Sequences(
                 starts=sequences.starts[block] - lo,
                 lengths=sequences.lengths[block],
                 ids=sequences.ids[block],
             )
-            jobs.append(
-                delayed(self._fill)(
-                    layers,
-                    X[lo:hi],
-                    mask[lo:hi],
-                    block_sequences,
-                    n_draws,
-                    np.random.default_rng(seed),
-                )
+            return self._fill(
+                layers, X[lo:hi], mask[lo:hi], block_sequences, n_draws, block_rng
             )
-        return np.concatenate(Parallel(n_jobs=self.n_jobs)(jobs), axis=1)
+
+        blocks = map_sequence_blocks(
+            fill_block, sequences.n_sequences, rng, self.n_jobs
+        )
+        return np.concatenate(blocks, axis=1)
 
     def _fill(self, layers, X, mask, sequences, n_draws, rng):
         """``n_draws`` on-line fills, all sequences and draws advancing together.

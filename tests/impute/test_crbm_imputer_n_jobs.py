@@ -7,7 +7,8 @@ from sklearn.utils._param_validation import InvalidParameterError
 
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm.datasets import make_oscillations
-from sklearn_crbm.impute import CRBMImputer, _crbm_imputer
+from sklearn_crbm.impute import CRBMImputer
+from sklearn_crbm.utils._parallel import BLOCK_SEQUENCES
 
 # 70 short sequences: more than one block of 32, so the work splits in three.
 X, IDS = make_oscillations(n_sequences=70, n_frames=12, random_state=0)
@@ -25,7 +26,7 @@ def imputer():
 
 
 def test_many_sequences_are_split_into_blocks():
-    assert 70 > 2 * _crbm_imputer._BLOCK_SEQUENCES
+    assert 70 > 2 * BLOCK_SEQUENCES
 
 
 @pytest.mark.parametrize("n_jobs", [2, -1])

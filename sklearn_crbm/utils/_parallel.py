@@ -1,0 +1,42 @@
+"""Splitting work on many sequences into blocks that run in parallel."""
+
+import numpy as np
+from sklearn.utils.parallel import Parallel, delayed
+
+__all__ = ["BLOCK_SEQUENCES", "map_sequence_blocks"]
+
+# Sequences handled together, vectorised, by one job.
+BLOCK_SEQUENCES = 32
+
+
+def map_sequence_blocks(work, n_sequences, rng, n_jobs=None):
+    """Run ``work(block, rng)`` on blocks of sequence indices, maybe in parallel.
+
+    Up to ``BLOCK_SEQUENCES`` sequences form a single block, run with ``rng``
+    itself.  More are split into near-equal blocks of consecutive sequences,
+    each run with its own generator seeded from ``rng``.  The blocks and their
+    seeds depend on ``n_sequences`` only, so ``n_jobs`` never changes results.
+
+    Parameters
+    ----------
+    work : callable
+        ``work(block, rng)`` with ``block`` an array of sequence indices.
+    n_sequences : int
+    rng : numpy.random.Generator
+    n_jobs : int, default=None
+        Passed to :class:`sklearn.utils.parallel.Parallel`.
+
+    Returns
+    -------
+    results : list
+        ``work``'s results, block by block in order.
+    """
+    n_blocks = -(-n_sequences // BLOCK_SEQUENCES)
+    if n_blocks <= 1:
+        return [work(np.arange(n_sequences), rng)]
+    seeds = rng.integers(np.iinfo(np.int64).max, size=n_blocks)
+    blocks = np.array_split(np.arange(n_sequences), n_blocks)
+    return Parallel(n_jobs=n_jobs)(
+        delayed(work)(block, np.random.default_rng(seed))
+        for block, seed in zip(blocks, seeds, strict=True)
+    )
