@@ -1,7 +1,7 @@
 """
-=================================================
+==================================================
 Filling in a lost leg on-line (the paper's Fig. 4)
-=================================================
+==================================================
 
 Motion capture loses markers.  Taylor, Hinton & Roweis (2006, §4.4) erase the
 left leg of a held-out walk from half-way through and let the trained model

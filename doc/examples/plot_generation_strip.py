@@ -1,7 +1,7 @@
 """
-======================================================
+=======================================================
 Walking and jogging from one model (the paper's Fig. 3)
-======================================================
+=======================================================
 
 Taylor, Hinton & Roweis (2006, §4.1) train a single conditional RBM on the
 walks and jogs of CMU subject 35 and let it generate: seeded with three

@@ -1,7 +1,7 @@
 """
-=====================================================
+=======================================================
 What the hidden units do over time (the paper's Fig. 1)
-=====================================================
+=======================================================
 
 The paper's Fig. 1 shows, for a trained model, the probability of each hidden
 unit being on given the data, frame by frame, over a sequence that changes

@@ -111,7 +111,7 @@ class CRBMImputer(
     ----------
     estimator_ : ConditionalRBM or StackedCRBM
         The fitted clone of ``estimator``.
-    mean_ : ndarray of shape (n_features_in_,)
+    mean_ : ndarray of shape (`n_features_in_`,)
         Mean training frame: where the missing channels of the first frame
         of a sequence start.
     n_features_in_ : int

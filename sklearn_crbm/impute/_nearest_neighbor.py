@@ -41,7 +41,7 @@ class NearestNeighborImputer(
 
     Attributes
     ----------
-    mean_ : ndarray of shape (n_features_in_,)
+    mean_ : ndarray of shape (`n_features_in_`,)
         Mean training frame: the fill of wholly missing frames that have no
         filled frame before them in their sequence.
     n_features_in_ : int

@@ -49,18 +49,18 @@ class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
 
     Attributes
     ----------
-    mean_ : ndarray of shape (n_features_in_,)
+    mean_ : ndarray of shape (`n_features_in_`,)
         Mean of every input feature, always computed: the constant features
         are restored at it.
-    var_ : ndarray of shape (n_features_in_,)
+    var_ : ndarray of shape (`n_features_in_`,)
         Variance (ddof=0) of every input feature, always computed: it
         decides which features are constant.
-    scale_ : ndarray of shape (n_features_in_,) or None
+    scale_ : ndarray of shape (`n_features_in_`,) or None
         ``sqrt(var_)``, with 1 for constant features; None when
         ``with_std=False``.
-    constant_mask_ : ndarray of bool of shape (n_features_in_,)
+    constant_mask_ : ndarray of bool of shape (`n_features_in_`,)
         True for the dropped (constant) features.
-    n_samples_seen_ : int or ndarray of shape (n_features_in_,)
+    n_samples_seen_ : int or ndarray of shape (`n_features_in_`,)
         Number of samples seen, per feature when some were NaN (NaN is
         ignored in fit and kept in transform, as in scikit-learn).
     n_features_in_ : int
@@ -191,7 +191,7 @@ class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
 
         Parameters
         ----------
-        X : array-like of shape (n_samples, n_features_in_)
+        X : array-like of shape (n_samples, `n_features_in_`)
             Data to scale.  NaN stays NaN.
         copy : bool or None, default=None
             Ignored apart from validation (the output is always a new
@@ -226,7 +226,7 @@ class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
 
         Returns
         -------
-        X_original : ndarray of shape (n_samples, n_features_in_)
+        X_original : ndarray of shape (n_samples, `n_features_in_`)
             Data in the original units, the constant features at their mean.
         """
         check_is_fitted(self)

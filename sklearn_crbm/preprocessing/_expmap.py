@@ -263,7 +263,7 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
 
         Returns
         -------
-        X_original : ndarray of shape (n_frames, n_features_in_)
+        X_original : ndarray of shape (n_frames, `n_features_in_`)
             Raw channels; angles in ``angle_unit``, within ``(-180, 180]``
             degrees (see Notes of the class).
         """
