@@ -45,6 +45,9 @@ _CHUNK_FRAMES = 4096
 _MAX_SEED_WINDOWS = 500
 # Mean-field iterations of the one-step-ahead prediction behind ``score``.
 _SCORE_MEAN_FIELD_STEPS = 10
+# Sequences generated together in one vectorised pass by ``sample``: one
+# frame of 100 sequences costs little more than one of 1, so blocks are large.
+_SAMPLE_BLOCK = 256
 # Standard deviation of the jitter added to the previous frame to start the
 # Gibbs chain of a new frame (REFERENCE.md, gen.m).
 _START_JITTER = 0.01
@@ -722,9 +725,9 @@ class ConditionalRBM(
             ``random_state``, so repeated calls give the same frames when
             that is an int.
         n_jobs : int, default=None
-            Number of jobs generating blocks of 32 sequences in parallel
+            Number of jobs generating blocks of 256 sequences in parallel
             (joblib; ``None`` means 1 unless in a
-            :obj:`joblib.parallel_backend` context).  Up to 32 sequences are
+            :obj:`joblib.parallel_backend` context).  Up to 256 sequences are
             generated together in one vectorised pass; the blocks and their
             random streams depend on ``n_sequences`` only, so the frames are
             the same for any ``n_jobs``.
@@ -767,7 +770,9 @@ class ConditionalRBM(
                 block_rng,
             )
 
-        blocks = map_sequence_blocks(generate_block, len(seed), rng, n_jobs)
+        blocks = map_sequence_blocks(
+            generate_block, len(seed), rng, n_jobs, block_size=_SAMPLE_BLOCK
+        )
         return np.concatenate(blocks).reshape(-1, self.n_features_in_)
 
     def _generate(

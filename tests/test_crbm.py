@@ -615,11 +615,11 @@ def test_sample_n_jobs_gives_the_same_frames():
     model = ConditionalRBM(6, order=2, n_iter=2, random_state=0).fit(
         X, sequence_ids=ids
     )
-    serial = model.sample(5, n_sequences=70, random_state=3)
-    parallel = model.sample(5, n_sequences=70, random_state=3, n_jobs=2)
-    assert serial.shape == (350, 5)
+    serial = model.sample(3, n_sequences=600, random_state=3)  # three blocks
+    parallel = model.sample(3, n_sequences=600, random_state=3, n_jobs=2)
+    assert serial.shape == (1800, 5)
     assert_array_equal(serial, parallel)
-    # up to 32 sequences are one vectorised block, which n_jobs leaves alone
+    # up to 256 sequences are one vectorised block, which n_jobs leaves alone
     assert_array_equal(
         model.sample(5, n_sequences=3, random_state=3),
         model.sample(5, n_sequences=3, random_state=3, n_jobs=2),

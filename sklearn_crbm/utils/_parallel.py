@@ -5,14 +5,16 @@ from sklearn.utils.parallel import Parallel, delayed
 
 __all__ = ["BLOCK_SEQUENCES", "map_sequence_blocks"]
 
-# Sequences handled together, vectorised, by one job.
+# Sequences handled together, vectorised, by one job of on-line fill-in.
 BLOCK_SEQUENCES = 32
 
 
-def map_sequence_blocks(work, n_sequences, rng, n_jobs=None):
+def map_sequence_blocks(
+    work, n_sequences, rng, n_jobs=None, block_size=BLOCK_SEQUENCES
+):
     """Run ``work(block, rng)`` on blocks of sequence indices, maybe in parallel.
 
-    Up to ``BLOCK_SEQUENCES`` sequences form a single block, run with ``rng``
+    Up to ``block_size`` sequences form a single block, run with ``rng``
     itself.  More are split into near-equal blocks of consecutive sequences,
     each run with its own generator seeded from ``rng``.  The blocks and their
     seeds depend on ``n_sequences`` only, so ``n_jobs`` never changes results.
@@ -25,13 +27,16 @@ def map_sequence_blocks(work, n_sequences, rng, n_jobs=None):
     rng : numpy.random.Generator
     n_jobs : int, default=None
         Passed to :class:`sklearn.utils.parallel.Parallel`.
+    block_size : int, default=BLOCK_SEQUENCES
+        Most sequences in one block.  Larger blocks vectorise better; smaller
+        ones give more parallel jobs.
 
     Returns
     -------
     results : list
         ``work``'s results, block by block in order.
     """
-    n_blocks = -(-n_sequences // BLOCK_SEQUENCES)
+    n_blocks = -(-n_sequences // block_size)
     if n_blocks <= 1:
         return [work(np.arange(n_sequences), rng)]
     seeds = rng.integers(np.iinfo(np.int64).max, size=n_blocks)
