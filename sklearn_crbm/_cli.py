@@ -178,6 +178,18 @@ def _add_model_options(parser, n_iter):
     parser.add_argument("--seed", type=int, default=0)
 
 
+def _model_from_args(args):
+    """The ConditionalRBM that ``demo`` and ``fit`` train, from the model options."""
+    return ConditionalRBM(
+        args.n_components,
+        order=args.order,
+        n_iter=args.n_iter,
+        history_noise=args.history_noise,
+        random_state=args.seed,
+        verbose=max(1, args.n_iter // 10),
+    )
+
+
 def _load_cmu35(data_home, subset):
     try:
         return load_cmu35(data_home, subset=subset)
@@ -211,14 +223,7 @@ def run_demo(args):
         "(exp maps, body-centred root, z-scores)"
     )
 
-    model = ConditionalRBM(
-        args.n_components,
-        order=args.order,
-        n_iter=args.n_iter,
-        history_noise=args.history_noise,
-        random_state=args.seed,
-        verbose=max(1, args.n_iter // 10),
-    )
+    model = _model_from_args(args)
     print(f"\ntraining {model!r}")
     imputer = CRBMImputer(model, n_particles=args.n_particles, random_state=args.seed)
     imputer.fit(Z, sequence_ids=train.sequence_ids)
@@ -425,19 +430,7 @@ def run_fit(args):
     train = _load_cmu35(args.data_home, "train")
     pipeline = Pipeline(
         make_motion_preprocessor(train.skeleton).steps
-        + [
-            (
-                "crbm",
-                ConditionalRBM(
-                    args.n_components,
-                    order=args.order,
-                    n_iter=args.n_iter,
-                    history_noise=args.history_noise,
-                    random_state=args.seed,
-                    verbose=max(1, args.n_iter // 10),
-                ),
-            )
-        ]
+        + [("crbm", _model_from_args(args))]
     )
     pipeline.fit(train.data, sequence_ids=train.sequence_ids)
     joblib.dump(pipeline, args.output)
