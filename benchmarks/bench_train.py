@@ -9,6 +9,10 @@ of one epoch from their shapes (``_common.cd_epoch_flops``) and divides the
 achieved rate by the rate of one large matrix product (``--peak-size``,
 default 2000 x 2000) timed in the same run, with the same dtype and threads.
 
+It also times the six matrix products of every minibatch alone
+(``products_only_epoch``, same shapes and layouts): the ceiling of any
+implementation that leaves these products to BLAS.
+
 For comparison it times, in the same run, a straightforward numpy CD-1
 (``naive_epoch`` below: the same update written the obvious way, with
 ``scipy.special.expit`` and fresh arrays for every intermediate), and the MIT
@@ -91,6 +95,48 @@ def naive_epoch(state, X, frames, batch_size, order, rng, momentum):
             state[key] += velocity
 
 
+def products_only_epoch(buffers, batch_sizes):
+    """Only the six matrix products of every minibatch of one CD-1 epoch.
+
+    The same shapes and memory layouts as ``cd_gradients`` (W and the
+    directed weights in Fortran order, as during ``fit``), into preallocated
+    outputs: the time no implementation that calls BLAS for these products
+    can beat, whatever it does between them.
+    """
+    W, dynamic, v, h, hist, vs, hs, delta, out_dyn, out_h, out_v, out_w, out_d = buffers
+    for n in batch_sizes:
+        np.matmul(hist[:n], dynamic.T, out=out_dyn[:n])
+        np.matmul(v[:n], W.T, out=out_h[:n])
+        np.matmul(h[:n], W, out=out_v[:n])
+        np.matmul(v[:n], W.T, out=out_h[:n])
+        np.matmul(hs[: 2 * n].T, vs[: 2 * n], out=out_w)
+        np.matmul(delta[:n].T, hist[:n], out=out_d)
+
+
+def products_buffers(n_features, n_components, order, batch_size, dtype):
+    rng = np.random.default_rng(0)
+    d, h, k, n = n_features, n_components, order * n_features, batch_size
+
+    def random(*shape, order="C"):
+        return np.asarray(rng.standard_normal(shape).astype(dtype), order=order)
+
+    return (
+        random(h, d, order="F"),
+        random(d + h, k, order="F"),
+        random(n, d),
+        random(n, h),
+        random(n, k),
+        random(2 * n, d),
+        random(2 * n, h),
+        random(n, d + h),
+        np.empty((n, d + h), dtype),
+        np.empty((n, h), dtype),
+        np.empty((n, d), dtype),
+        np.empty((h, d), dtype, order="F"),
+        np.empty((d + h, k), dtype, order="F"),
+    )
+
+
 def naive_state(n_features, n_components, order, dtype, seed=0):
     rng = np.random.default_rng(seed)
     shapes = {
@@ -114,7 +160,14 @@ def run_config(name, X, ids, config, dtype, threads, epochs, repeats, peak_size,
     flops = cd_epoch_flops(
         len(valid), X.shape[1], config["n_components"], config["order"]
     )
-    times = {"sklearn_crbm": [], "naive numpy": []}
+    times = {"sklearn_crbm": [], "naive numpy": [], "matrix products alone": []}
+    batch_sizes = [
+        len(b)
+        for b in balanced_batches(valid, config["batch_size"], np.random.default_rng(0))
+    ]
+    buffers = products_buffers(
+        X.shape[1], config["n_components"], config["order"], config["batch_size"], dtype
+    )
     peaks = []
     with threadpool_limits(threads):
         model_for(config, 1, dtype).fit(X, sequence_ids=ids)  # warm up
@@ -141,6 +194,13 @@ def run_config(name, X, ids, config, dtype, threads, epochs, repeats, peak_size,
             times["sklearn_crbm"].append(time_both(ours))
             if naive:
                 times["naive numpy"].append(time_both(baseline))
+            times["matrix products alone"].append(
+                time_both(
+                    lambda: [
+                        products_only_epoch(buffers, batch_sizes) for _ in range(epochs)
+                    ]
+                )
+            )
     peak_wall, peak_cpu = (max(p) for p in zip(*peaks, strict=True))
     rows = []
     for impl, ts in times.items():

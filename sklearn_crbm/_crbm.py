@@ -22,6 +22,7 @@ from ._crbm_math import (
     BINARY,
     CDWorkspace,
     CRBMParameters,
+    MomentumUpdate,
     cd_gradients,
     dynamic_biases,
     free_energy,
@@ -423,22 +424,17 @@ class ConditionalRBM(
 
     def _train(self, X, frames, n_epochs):
         params = self._params()
-        # W, the directed weights and their velocities in Fortran order: the
-        # matrix products of these shapes run faster in BLAS's orientation
-        # for it (several per cent per epoch); stored back in C order.
-        params.weights = np.asfortranarray(params.weights)
-        params.dynamic = np.asfortranarray(params.dynamic)
-        self._velocities = velocities = [np.asfortranarray(v) for v in self._velocities]
+        # params' arrays become views of one buffer, updated in place
+        update = MomentumUpdate(params, self._velocities)
+        self._velocities = list(update.velocities)
         # Minibatches gather rows: from a Fortran-ordered X (what many
         # transformers return) every row would be a strided read.
         X = np.ascontiguousarray(X)
-        decays = (self.weight_decay, 0.0, 0.0, self.weight_decay)
         plan_batches = (
             balanced_batches if self.batching == "balanced" else shuffled_batches
         )
         n_lags = params.n_lags
-        # Buffers reused by every minibatch; cd_gradients accumulates
-        # ``velocity = momentum * velocity + lr / n * gradient`` in place.
+        # Buffers reused by every minibatch
         workspace = CDWorkspace(params, self.batch_size)
         start = time.perf_counter()
         for _ in range(n_epochs):
@@ -463,20 +459,12 @@ class ConditionalRBM(
                     batch_history,
                     self.cd_steps,
                     rng,
-                    out=velocities,
+                    out=update.statistics,
                     scale=self.learning_rate / n,
-                    momentum=momentum,
                     workspace=workspace,
                 )
                 squared_error += error
-                for array, velocity, decay, scratch in zip(
-                    params.arrays(), velocities, decays, workspace.scratch, strict=True
-                ):
-                    if decay:
-                        velocity -= np.multiply(
-                            array, self.learning_rate * decay, out=scratch
-                        )
-                    array += velocity
+                update.apply(momentum, self.learning_rate, self.weight_decay)
             self.n_iter_ += 1
             self.reconstruction_error_ = squared_error / len(frames)
             if not params.is_finite() or not np.isfinite(squared_error):
@@ -817,9 +805,14 @@ class ConditionalRBM(
 
 
 def _c_ordered(params):
-    """``params`` with its 2-D arrays in C order, as fitted attributes are kept."""
+    """``params`` with arrays of their own (2-D ones in C order), as fitted.
+
+    During training they are views of one buffer (``MomentumUpdate``).
+    """
     params.weights = np.ascontiguousarray(params.weights)
     params.dynamic = np.ascontiguousarray(params.dynamic)
+    params.hidden_bias = params.hidden_bias.copy()
+    params.visible_bias = params.visible_bias.copy()
     return params
 
 

@@ -26,10 +26,46 @@ N(c_hat + W.T h, I)``.  With binary visibles the quadratic term becomes
 ``-c_hat . v`` and ``p(v_i = 1 | h) = sigmoid(c_hat_i + (W.T h)_i)``.
 """
 
+import math
+
 import numpy as np
 
 GAUSSIAN = "gaussian"
 BINARY = "binary"
+
+# float32 exponents of 1.0 and 2.0: OR-ed onto 23 random mantissa bits they
+# give floats uniform on [1, 2) and [2, 4) without integer-to-float conversion
+_FLOAT32_ONE_BITS = np.uint32(0x3F800000)
+_FLOAT32_TWO_BITS = np.uint32(0x40000000)
+_MIN_BIT_DRAWS = 4096
+
+
+def uniform(rng, shape, dtype, out=None, *, symmetric=False):
+    """Uniform draws on [0, 1), or on [-1, 1) if ``symmetric``, in ``dtype``.
+
+    float64 draws come from ``rng.random`` (53 random bits).  float32 draws
+    take 23 random bits each, two per 64-bit output of the bit generator,
+    as the mantissa of a float in [1, 2) (or [2, 4) if ``symmetric``) from
+    which 1 (or 3) is subtracted: no integer-to-float conversion, about
+    two thirds of the time of ``rng.random(dtype=np.float32)``, which
+    matters in Gibbs sampling where these draws are a large part of every
+    step.  Fewer than ``_MIN_BIT_DRAWS`` float32 draws (one sequence, where
+    the extra numpy calls cost more than they save) come from
+    ``rng.random`` too.  All are reproducible from ``rng``'s state.
+    """
+    dtype = np.dtype(dtype)
+    size = math.prod(shape)
+    if dtype != np.float32 or size < _MIN_BIT_DRAWS:
+        draws = rng.random(shape, dtype=dtype, out=out)
+        if symmetric:
+            draws *= 2
+            draws -= 1
+        return draws
+    bits = rng.bit_generator.random_raw((size + 1) // 2).view(np.uint32)[:size]
+    np.right_shift(bits, 9, out=bits)
+    np.bitwise_or(bits, _FLOAT32_TWO_BITS if symmetric else _FLOAT32_ONE_BITS, out=bits)
+    floats = bits.view(np.float32).reshape(shape)
+    return np.subtract(floats, 3 if symmetric else 1, out=out)
 
 
 def logistic(activation, out=None):
@@ -252,41 +288,82 @@ def sample_bernoulli(probabilities, rng, out=None):
     One uniform draw per entry, ``state = uniform < probability``; ``out``
     (not ``probabilities`` itself) receives the uniforms, then the states.
     """
-    uniform = rng.random(probabilities.shape, dtype=probabilities.dtype, out=out)
-    return np.less(uniform, probabilities, out=uniform)
+    draws = uniform(rng, probabilities.shape, probabilities.dtype, out=out)
+    return np.less(draws, probabilities, out=draws)
 
 
-def sample_hidden_states(
-    params, visible, hidden_bias, rng, out=None, work=None, *, negated=False
-):
+class HiddenSampler:
+    """Draws binary hidden states from p(h | v, history) for fixed dynamic biases.
+
+    ``h_j = 1`` where a uniform draw ``u`` falls below ``sigmoid(a_j)``, ``a =
+    v W^T + b_hat``.  The test is evaluated in the form that is fastest for
+    the dtype, each exact up to rounding at the boundary:
+
+    - float32: ``2u - 1 < tanh(a / 2)``, with ``W / 2`` and ``b_hat / 2``
+      prepared once (halving is exact) and ``2u - 1`` drawn directly;
+    - float64: ``u * (1 + exp(-a)) < 1``, with ``-b_hat`` prepared once
+      (numpy's float64 ``tanh`` is slower than ``exp``).
+
+    A Gibbs chain prepares one sampler per frame and calls it at every step.
+
+    Parameters
+    ----------
+    params : CRBMParameters
+    hidden_bias : ndarray of shape (n, n_components)
+        The dynamic hidden biases ``b_hat``.
+    """
+
+    def __init__(self, params, hidden_bias):
+        self._tanh = params.dtype == np.float32
+        # a affine map of the activation a: a / 2 (tanh) or -a (exp)
+        self._scale = 0.5 if self._tanh else -1.0
+        self.weights = params.weights * 0.5 if self._tanh else params.weights
+        self.bias = np.multiply(hidden_bias, self._scale, dtype=params.dtype)
+
+    def __call__(self, visible, rng, out, work, *, hidden_noise=0.0, noise=None):
+        """States for ``visible`` (shape ``(n, n_features)``) into ``out``.
+
+        ``work`` (shape ``(n, n_components)``) is scratch; neither it nor
+        ``out`` may be an input.  ``hidden_noise`` adds ``N(0,
+        hidden_noise^2)`` to every hidden bias for this draw (paper §4.3);
+        ``noise`` is then a further scratch array of that shape.
+
+        Call it under ``np.errstate(over="ignore", under="ignore",
+        invalid="ignore")`` (a Gibbs loop enters it once): in float64
+        ``exp(-a)`` overflows where ``p = 0``, and ``inf * 0`` (``p = 0``,
+        ``u = 0``) compares False, as it should.
+        """
+        bias = self.bias
+        if hidden_noise:
+            bias = rng.standard_normal(bias.shape, dtype=bias.dtype, out=noise)
+            bias *= self._scale * hidden_noise
+            bias += self.bias
+        activation = np.matmul(visible, self.weights.T, out=work)
+        if self._tanh:
+            activation += bias
+            np.tanh(activation, out=activation)
+            draws = uniform(rng, activation.shape, np.float32, out, symmetric=True)
+            return np.less(draws, activation, out=draws)
+        np.subtract(bias, activation, out=activation)
+        draws = uniform(rng, activation.shape, activation.dtype, out=out)
+        np.exp(activation, out=activation)
+        activation += 1
+        activation *= draws
+        return np.less(activation, 1, out=draws)
+
+
+def sample_hidden_states(params, visible, hidden_bias, rng, out=None, work=None):
     """Binary hidden states drawn from p(h | v, history), one uniform each.
 
-    The test ``uniform < p`` with ``p = 1 / (1 + exp(-a))`` is evaluated as
-    ``uniform * (1 + exp(-a)) < 1``: the same draw (up to rounding at the
-    boundary) without the division.  ``out`` receives the states and
-    ``work`` (same shape, ``(n, n_components)``) is scratch; neither may be
-    an input.  With ``negated=True`` ``hidden_bias`` holds ``-b_hat`` (a
-    caller that uses one bias for many steps negates it once).
+    ``out`` receives the states and ``work`` (shape ``(n, n_components)``)
+    is scratch; neither may be an input.  See :class:`HiddenSampler`, which
+    a caller drawing many times with the same biases should use directly.
     """
+    shape = (visible.shape[0], params.n_components)
+    out = np.empty(shape, params.dtype) if out is None else out
+    work = np.empty(shape, params.dtype) if work is None else work
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-        return _sample_hidden_states(
-            params, visible, hidden_bias, rng, out, work, negated
-        )
-
-
-def _sample_hidden_states(params, visible, hidden_bias, rng, out, work, negated):
-    # callers ignore overflow in exp (p = 0) and inf * 0 (p = 0 and u = 0)
-    activation = np.matmul(visible, params.weights.T, out=work)
-    if negated:
-        np.subtract(hidden_bias, activation, out=activation)
-    else:
-        activation += hidden_bias
-        np.negative(activation, out=activation)
-    uniform = rng.random(activation.shape, dtype=activation.dtype, out=out)
-    np.exp(activation, out=activation)
-    activation += 1
-    activation *= uniform
-    return np.less(activation, 1, out=uniform)
+        return HiddenSampler(params, hidden_bias)(visible, rng, out, work)
 
 
 def sample_visible_states(params, means, rng, out=None):
@@ -323,8 +400,7 @@ class CDWorkspace:
     Sized for minibatches of up to ``batch_size`` frames of one model, so
     that a training loop allocates nothing per minibatch.  ``visible(n)`` and
     ``history`` are where a trainer gathers a minibatch (no copy in
-    :func:`cd_gradients` then); ``scratch`` holds arrays shaped like
-    ``params.arrays()`` that are free between calls.
+    :func:`cd_gradients` then).
     """
 
     def __init__(self, params, batch_size):
@@ -338,7 +414,7 @@ class CDWorkspace:
         self.biases = np.empty((n, d + h), dtype)
         self.delta = np.empty((n, d + h), dtype)
         self.history = np.empty((n, params.n_lags * d), dtype)
-        self.scratch = tuple(np.empty_like(a) for a in params.arrays())
+        self.ones = np.ones(n, dtype)
         self.bias_sums = np.empty(d + h, dtype)
         self.dynamic_mask = None
         if params.order != params.hidden_order:
@@ -350,6 +426,83 @@ class CDWorkspace:
         return self.visible_stack[:n]
 
 
+class MomentumUpdate:
+    """Parameters, velocities and statistics of one CRBM in flat buffers.
+
+    After every minibatch training applies (the original code's update)::
+
+        velocity = momentum * velocity + statistic         (all arrays)
+        velocity -= learning_rate * weight_decay * param   (W, A and B only)
+        param += velocity
+
+    where ``statistic`` is ``learning_rate / n`` times the CD gradient
+    (:func:`cd_gradients` writes it into :attr:`statistics`).  The
+    constructor copies ``params`` and ``velocities`` into flat buffers laid
+    out alike (``W`` and ``dynamic`` first, in Fortran order, the orientation
+    in which BLAS runs these products fastest, then the biases) and points
+    ``params``'s arrays at views of the first, so that each line above is
+    one or two numpy passes over a whole buffer instead of several per array.
+
+    Parameters
+    ----------
+    params : CRBMParameters
+        Its arrays are replaced by views of :attr:`parameters`.
+    velocities : sequence of ndarray
+        Shaped like ``params.arrays()``.
+
+    Attributes
+    ----------
+    parameters, velocity : ndarray of shape (n_parameters,)
+    velocities, statistics : tuple of ndarray
+        Views of :attr:`velocity` and of a scratch buffer, shaped like
+        ``params.arrays()``.
+    """
+
+    _ARRAYS = ("weights", "hidden_bias", "visible_bias", "dynamic")
+    _LAYOUT = ("weights", "dynamic", "hidden_bias", "visible_bias")  # decayed first
+
+    def __init__(self, params, velocities):
+        shapes = [getattr(params, name).shape for name in self._LAYOUT]
+        sizes = [math.prod(shape) for shape in shapes]
+        ends = np.cumsum(sizes)
+        self.parameters = np.empty(ends[-1], params.dtype)
+        self.velocity = np.empty_like(self.parameters)
+        self._statistic = np.empty_like(self.parameters)
+        self._decayed = slice(0, int(ends[1]))
+
+        def views(flat):
+            views = {
+                name: flat[end - size : end].reshape(shape, order="F")
+                for name, shape, size, end in zip(
+                    self._LAYOUT, shapes, sizes, ends, strict=True
+                )
+            }
+            return tuple(views[name] for name in self._ARRAYS)
+
+        parameters = views(self.parameters)
+        for name, array in zip(self._ARRAYS, parameters, strict=True):
+            array[...] = getattr(params, name)
+            setattr(params, name, array)
+        for array, value in zip(views(self.velocity), velocities, strict=True):
+            array[...] = value
+        self.velocities = views(self.velocity)
+        self.statistics = views(self._statistic)
+
+    def apply(self, momentum, learning_rate, weight_decay):
+        """Fold :attr:`statistics` into the velocities and those into the parameters."""
+        velocity, statistic = self.velocity, self._statistic
+        velocity *= momentum
+        velocity += statistic
+        if weight_decay:  # the statistics are spent: their buffer is scratch
+            decay = np.multiply(
+                self.parameters[self._decayed],
+                learning_rate * weight_decay,
+                out=statistic[self._decayed],
+            )
+            velocity[self._decayed] -= decay
+        self.parameters += velocity
+
+
 def cd_gradients(
     params,
     visible,
@@ -359,7 +512,6 @@ def cd_gradients(
     *,
     out=None,
     scale=1.0,
-    momentum=0.0,
     workspace=None,
 ):
     """Contrastive-divergence statistics of one minibatch (paper Eqs. 4-7, §2.2).
@@ -374,8 +526,9 @@ def cd_gradients(
     The weight statistics ``h_data.T @ v - h_recon.T @ v_recon`` are one
     matrix product of the stacked ``[h_data; h_recon]`` and ``[v; -v_recon]``;
     those of both directed groups are one product of ``[v - v_recon, h_data -
-    h_recon]`` with the history.  ``scale`` is applied to these small
-    factors, not to the products.
+    h_recon]`` with the history; ``scale`` multiplies these small factors,
+    not the products.  :class:`MomentumUpdate` turns the statistics into
+    parameter updates.
 
     Parameters
     ----------
@@ -385,11 +538,9 @@ def cd_gradients(
     cd_steps : int
     rng : numpy.random.Generator
     out : tuple of ndarray, default=None
-        Arrays shaped like ``params.arrays()``.  If given, the statistics are
-        accumulated into them as ``out[k] = momentum * out[k] + scale *
-        gradient[k]`` (the momentum update of velocities); otherwise new
-        arrays hold ``scale * gradient``.
-    scale, momentum : float
+        Arrays shaped like ``params.arrays()`` that receive ``scale *
+        gradient`` (new arrays if None).
+    scale : float
     workspace : CDWorkspace, default=None
         Buffers for minibatches of at least ``n`` frames.
 
@@ -407,7 +558,6 @@ def cd_gradients(
         workspace = CDWorkspace(params, n)
     if out is None:
         out = tuple(np.zeros_like(a) for a in params.arrays())
-        momentum = 0.0
     stacked_visible = workspace.visible_stack[: 2 * n]
     stacked_hidden = workspace.hidden_stack[: 2 * n]
     data, reconstruction = stacked_visible[:n], stacked_visible[n:]
@@ -418,27 +568,21 @@ def cd_gradients(
     visible_bias, hidden_bias = dynamic_biases(
         params, history, out=workspace.biases[:n]
     )
-    sample_hidden_states(
-        params,
-        data,
-        hidden_bias,
-        rng,
-        out=positive_states,
-        work=workspace.hidden[:n],
-    )
+    sample_hidden = HiddenSampler(params, hidden_bias)
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        sample_hidden(data, rng, out=positive_states, work=workspace.hidden[:n])
 
     hidden = positive_states
     for step in range(cd_steps):
         visible_means(params, hidden, visible_bias, out=reconstruction)
         if step + 1 < cd_steps:
-            hidden = sample_hidden_states(
-                params,
-                reconstruction,
-                hidden_bias,
-                rng,
-                out=workspace.hidden[:n],
-                work=negative_probabilities,
-            )
+            with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+                hidden = sample_hidden(
+                    reconstruction,
+                    rng,
+                    out=workspace.hidden[:n],
+                    work=negative_probabilities,
+                )
         else:
             hidden_probabilities(
                 params, reconstruction, hidden_bias, out=negative_probabilities
@@ -449,27 +593,19 @@ def cd_gradients(
     np.subtract(positive_states, negative_probabilities, out=delta[:, d:])
     squared_error = float(np.einsum("ij,ij->", visible_delta, visible_delta))
 
-    # the scale goes into the factors: [v; -v_recon] * scale and delta * scale
+    # the scale goes into the small factors: [v; -v_recon] and delta
     data *= scale
     np.multiply(reconstruction, -scale, out=reconstruction)
     delta *= scale
-    statistics = list(out if momentum == 0 else workspace.scratch)
-    np.matmul(stacked_hidden.T, stacked_visible, out=statistics[0])
-    bias_sums = np.sum(delta, axis=0, out=workspace.bias_sums)
-    statistics[1:3] = bias_sums[d:], bias_sums[:d]
+    weights_statistic, hidden_statistic, visible_statistic, dynamic_statistic = out
+    np.matmul(stacked_hidden.T, stacked_visible, out=weights_statistic)
+    bias_sums = np.dot(workspace.ones[:n], delta, out=workspace.bias_sums)
+    visible_statistic[...] = bias_sums[:d]
+    hidden_statistic[...] = bias_sums[d:]
     if params.n_lags:
-        np.matmul(delta.T, history, out=statistics[3])
+        np.matmul(delta.T, history, out=dynamic_statistic)
         if workspace.dynamic_mask is not None:
-            statistics[3] *= workspace.dynamic_mask
-    else:
-        statistics[3][...] = 0
-    for velocity, statistic in zip(out, statistics, strict=True):
-        if momentum == 0:
-            if velocity is not statistic:
-                np.copyto(velocity, statistic)
-        else:
-            velocity *= momentum
-            velocity += statistic
+            dynamic_statistic *= workspace.dynamic_mask
     return out, squared_error
 
 
@@ -511,21 +647,16 @@ def gibbs_frames(
     # every step works in these buffers: no allocation inside the loop
     visible = start.copy()
     visible_bias = np.ascontiguousarray(visible_bias)
-    negative_bias = np.negative(hidden_bias)  # -b_hat, contiguous, once
-    hidden = np.empty_like(negative_bias)
-    work = np.empty_like(negative_bias)
-    noisy_bias = np.empty_like(negative_bias) if hidden_noise else None
+    sample_hidden = HiddenSampler(params, hidden_bias)
+    hidden = np.empty_like(sample_hidden.bias)
+    work = np.empty_like(hidden)
+    noise = np.empty_like(hidden) if hidden_noise else None
     drawn = np.empty_like(visible) if sample_visibles else None
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         for _ in range(n_gibbs):
-            bias = negative_bias
-            if hidden_noise:  # -(b_hat + noise * z), the draws as before
-                bias = rng.standard_normal(
-                    hidden.shape, dtype=hidden.dtype, out=noisy_bias
-                )
-                bias *= -hidden_noise
-                bias += negative_bias
-            _sample_hidden_states(params, visible, bias, rng, hidden, work, True)
+            sample_hidden(
+                visible, rng, hidden, work, hidden_noise=hidden_noise, noise=noise
+            )
             visible_means(params, hidden, visible_bias, out=visible)
             if sample_visibles:
                 visible, drawn = (
