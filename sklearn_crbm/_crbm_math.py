@@ -352,20 +352,6 @@ class HiddenSampler:
         return np.less(activation, 1, out=draws)
 
 
-def sample_hidden_states(params, visible, hidden_bias, rng, out=None, work=None):
-    """Binary hidden states drawn from p(h | v, history), one uniform each.
-
-    ``out`` receives the states and ``work`` (shape ``(n, n_components)``)
-    is scratch; neither may be an input.  See :class:`HiddenSampler`, which
-    a caller drawing many times with the same biases should use directly.
-    """
-    shape = (visible.shape[0], params.n_components)
-    out = np.empty(shape, params.dtype) if out is None else out
-    work = np.empty(shape, params.dtype) if work is None else work
-    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-        return HiddenSampler(params, hidden_bias)(visible, rng, out, work)
-
-
 def sample_visible_states(params, means, rng, out=None):
     """Draws from p(v | h, history) given its means: N(mean, I) or Bernoulli(mean).
 
