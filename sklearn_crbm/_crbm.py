@@ -10,7 +10,7 @@ from sklearn.base import (
     TransformerMixin,
     _fit_context,
 )
-from sklearn.utils import check_random_state
+from sklearn.utils import Bunch, check_random_state
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import (
     _check_sample_weight,
@@ -25,11 +25,11 @@ from ._crbm_math import (
     MomentumUpdate,
     cd_gradients,
     dynamic_biases,
-    free_energy,
     gibbs_frames,
     hidden_probabilities,
     mean_field_prediction,
 )
+from ._likelihood import frame_log_likelihood
 from .utils._fitting import unfitted_on_error
 from .utils._parallel import map_sequence_blocks
 from .utils._persistence import VersionedPickleMixin
@@ -44,7 +44,7 @@ from .utils._sequences import (
 _CHUNK_FRAMES = 4096
 # How many windows of training frames ``fit`` keeps to seed ``sample``.
 _MAX_SEED_WINDOWS = 500
-# Mean-field iterations of the one-step-ahead prediction behind ``score``.
+# Mean-field iterations of the one-step-ahead prediction (``predict_next``).
 _SCORE_MEAN_FIELD_STEPS = 10
 # Sequences generated together in one vectorised pass by ``sample``: one
 # frame of 100 sequences costs little more than one of 1, so blocks are large.
@@ -132,6 +132,18 @@ class ConditionalRBM(
         slightly larger one-step prediction error.
     n_iter : int, default=200
         Number of epochs (passes over the trainable frames).
+    ais_steps : int, default=50
+        Intermediate distributions of the annealed importance sampling
+        behind :meth:`score` and :meth:`score_samples` (used when the hidden
+        units are too many to enumerate).  On CMU 35 50 x 2 chains stay
+        within 0.01 nats/frame of 500 x 16 for models with history, at a
+        few percent of the cost of training.  A model without history
+        (``order=0`` and ``hidden_order=0``) has one partition function for
+        all frames and anneals it once, with five times as many, from up to
+        256 of the frames scored.
+    ais_chains : int, default=2
+        Annealing chains per frame (per starting frame for a model without
+        history).
     random_state : int, RandomState instance or None, default=None
         Controls initialisation, minibatches, sampling during training and,
         unless ``sample`` is given its own, generation.  Pass an int for
@@ -217,6 +229,8 @@ class ConditionalRBM(
         "batching": [StrOptions({"balanced", "shuffled"})],
         "history_noise": [Interval(Real, 0, None, closed="left")],
         "n_iter": [Interval(Integral, 1, None, closed="left")],
+        "ais_steps": [Interval(Integral, 1, None, closed="left")],
+        "ais_chains": [Interval(Integral, 1, None, closed="left")],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
     }
@@ -247,6 +261,8 @@ class ConditionalRBM(
         batching="balanced",
         history_noise=0.0,
         n_iter=200,
+        ais_steps=50,
+        ais_chains=2,
         random_state=None,
         verbose=0,
     ):
@@ -263,6 +279,8 @@ class ConditionalRBM(
         self.batching = batching
         self.history_noise = history_noise
         self.n_iter = n_iter
+        self.ais_steps = ais_steps
+        self.ais_chains = ais_chains
         self.random_state = random_state
         self.verbose = verbose
 
@@ -363,6 +381,11 @@ class ConditionalRBM(
     @property
     def _n_lags(self):
         return max(self.order, self._hidden_order)
+
+    @property
+    def history_length(self):
+        """Past frames a frame is conditioned on: ``max(order, hidden_order)``."""
+        return self._n_lags
 
     @property
     def _hidden_order(self):
@@ -549,14 +572,17 @@ class ConditionalRBM(
         return hidden
 
     def score_samples(self, X, *, sequence_ids=None):
-        """Negative free energy ``-F(x_t | history)`` of every frame.
+        """Conditional log-likelihood ``log p(x_t | history)`` of every frame, in nats.
 
-        ``exp(-F)`` is proportional to ``p(x_t | history)``; the constant of
-        proportionality depends on the history and on the model, so compare
-        values of one model on different frames, not across models (use
-        :meth:`score` for that).  For the first ``max(order, hidden_order)``
-        frames of each sequence the missing past frames are replaced by the
-        sequence's first frame (edge padding).
+        Exact when enumerating the ``2 ** n_components`` hidden
+        configurations costs less than annealing; otherwise estimated by
+        annealed importance sampling with ``ais_steps`` intermediate
+        distributions and ``ais_chains`` chains per frame, seeded by
+        ``random_state`` (see :meth:`estimate_log_likelihood` for the
+        estimate's standard error and a conservative reverse estimate).
+        For the first ``max(order, hidden_order)`` frames of each sequence
+        the missing past frames are replaced by the sequence's first frame
+        (edge padding).
 
         Parameters
         ----------
@@ -567,17 +593,92 @@ class ConditionalRBM(
 
         Returns
         -------
-        scores : ndarray of shape (n_frames,)
-            Negative free energy of each frame.
+        log_likelihood : ndarray of shape (n_frames,)
+            Log density (Gaussian visibles) or log probability (binary) of
+            each frame given its history, in the dtype of the model.
         """
         X, sequences = self._check_inference_input(X, sequence_ids)
+        return self._log_likelihood(X, sequences).log_likelihood.astype(X.dtype)
+
+    def estimate_log_likelihood(
+        self, X, *, sequence_ids=None, method="auto", reverse=True, random_state=None
+    ):
+        """``log p(x_t | history)`` of every frame, with how far to trust it.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            All sequences stacked, each contiguous and in time order.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+        method : {"auto", "exact", "ais"}, default="auto"
+            ``"exact"`` enumerates the hidden configurations (at most 24
+            hidden units), ``"ais"`` anneals, ``"auto"`` takes the cheaper.
+        reverse : bool, default=True
+            Also run reverse annealing (RAISE, Burda et al. 2015) from every
+            frame: a conservative estimate, low on average, that costs as
+            much again.
+        random_state : int, RandomState instance or None, default=None
+            Seeds the annealing; ``None`` uses the estimator's
+            ``random_state`` (what :meth:`score` uses).
+
+        Returns
+        -------
+        result : :class:`~sklearn.utils.Bunch`
+            log_likelihood : ndarray of shape (n_frames,)
+                As :meth:`score_samples` gives it (forward AIS is high on
+                average: its partition function is low on average).
+            lower : ndarray of shape (n_frames,) or None
+                The reverse estimate (equal to ``log_likelihood`` when
+                exact); the gap between the two bounds the error of either
+                when the annealing is good.
+            standard_error : ndarray of shape (n_frames,)
+                Standard error of the forward estimate across chains (0
+                when exact).
+            method : str
+                ``"exact"`` or ``"ais"``.
+
+        Examples
+        --------
+        >>> from sklearn_crbm import ConditionalRBM
+        >>> from sklearn_crbm.datasets import make_oscillations
+        >>> X, ids = make_oscillations(n_sequences=4, n_frames=40, random_state=0)
+        >>> model = ConditionalRBM(8, order=2, n_iter=20, random_state=0)
+        >>> model = model.fit(X, sequence_ids=ids)
+        >>> result = model.estimate_log_likelihood(X, sequence_ids=ids, method="ais")
+        >>> bool((result.lower <= result.log_likelihood + 0.5).all())
+        True
+        """
+        if method not in ("auto", "exact", "ais"):
+            raise ValueError(
+                f"method must be 'auto', 'exact' or 'ais', got {method!r}."
+            )
+        X, sequences = self._check_inference_input(X, sequence_ids)
+        result = self._log_likelihood(
+            X,
+            sequences,
+            method=method,
+            reverse=reverse,
+            random_state=random_state,
+        )
+        return Bunch(**result._asdict())
+
+    def _log_likelihood(
+        self, X, sequences, method="auto", reverse=False, random_state=None
+    ):
         params = self._params()
-        scores = np.empty(X.shape[0], dtype=X.dtype)
-        for rows, visible_bias, hidden_bias in self._iter_dynamic_biases(
-            params, X, sequences
-        ):
-            scores[rows] = -free_energy(params, X[rows], visible_bias, hidden_bias)
-        return scores
+        variance = getattr(self, "visible_variance_", None)
+        return frame_log_likelihood(
+            params,
+            None if variance is None else np.sqrt(variance),
+            X,
+            self._iter_dynamic_biases(params, X, sequences),
+            method=method,
+            n_steps=self.ais_steps,
+            n_chains=self.ais_chains,
+            reverse=reverse,
+            rng=_rng_from(self.random_state if random_state is None else random_state),
+        )
 
     def predict_next(self, X, *, sequence_ids=None):
         """One-step-ahead prediction of every frame from its history alone.
@@ -618,17 +719,17 @@ class ConditionalRBM(
         return predicted
 
     def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
-        """Negative one-step-ahead prediction error; higher is better.
+        """Mean conditional log-likelihood per frame, in nats; higher is better.
 
-        The mean, over every frame that has a complete history in its own
-        sequence and over features, of the squared difference between the
-        frame and :meth:`predict_next`'s prediction from its history.  It is
-        measured in the units of ``X`` (standardised data: fractions of a
-        standard deviation), so models with any ``n_components``, ``order``
-        or ``hidden_order`` can be compared on held-out sequences, e.g. by
-        ``GridSearchCV(scoring=None)``.  A model without history
-        (``order=0``) predicts the same frame everywhere and scores like a
-        constant prediction.
+        The mean of :meth:`score_samples` over every frame that has a
+        complete history in its own sequence: the held-out log-likelihood
+        ``log p(x_t | x_{t-1}, ..., x_{t-order})`` per frame, comparable
+        across ``n_components``, ``order``, ``hidden_order`` and visible
+        variances on the same frames, so that ``GridSearchCV(scoring=None)``
+        picks among them.  Exact for few hidden units, annealed importance
+        sampling otherwise (``ais_steps``, ``ais_chains``, seeded by
+        ``random_state``).  The one-step prediction error is
+        :func:`~sklearn_crbm.model_selection.make_prediction_scorer`.
 
         Parameters
         ----------
@@ -645,7 +746,7 @@ class ConditionalRBM(
         Returns
         -------
         score : float
-            Negative mean squared one-step-ahead prediction error.
+            Mean log-likelihood per frame.
         """
         X, sequences = self._check_inference_input(X, sequence_ids)
         frames = sequences.valid_frames(self._n_lags)
@@ -657,9 +758,9 @@ class ConditionalRBM(
         weights = None
         if sample_weight is not None:
             weights = _check_sample_weight(sample_weight, X)[frames]
-        predicted = self._predict_frames(self._params(), X, sequences, frames)
-        errors = np.mean(np.square(X[frames] - predicted), axis=1)
-        return -float(np.average(errors, weights=weights))
+        # every frame, as score_samples anneals them: the same random numbers
+        log_likelihood = self._log_likelihood(X, sequences).log_likelihood[frames]
+        return float(np.average(log_likelihood, weights=weights))
 
     # ----------------------------------------------------------- generation
 

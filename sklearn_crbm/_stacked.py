@@ -30,13 +30,16 @@ from ._crbm_math import (
     mean_field_prediction,
     visible_means,
 )
+from ._likelihood import stack_log_likelihood_bound
 from .utils._persistence import VersionedPickleMixin
 from .utils._sequences import check_sequence_ids, frame_history
 
 __all__ = ["StackedCRBM"]
 
-# Mean-field iterations of the top layer's one-step-ahead prediction (score).
+# Mean-field iterations of the top layer's one-step-ahead prediction.
 _SCORE_MEAN_FIELD_STEPS = 10
+# Draws of the lower layers' hidden units per frame in the likelihood bound.
+_BOUND_SAMPLES = 10
 # How many windows of training frames ``fit`` keeps to seed ``sample``.
 _MAX_SEED_WINDOWS = 500
 
@@ -526,16 +529,75 @@ class StackedCRBM(
             predicted = visible_means(p, predicted, visible_bias)
         return predicted
 
-    def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
-        """Negative one-step-ahead prediction error of the stack; higher is better.
+    def score_samples(self, X, *, sequence_ids=None):
+        """A lower bound on ``log p(x_t | history)`` of every frame, in nats.
 
-        The mean, over every frame with :attr:`history_length` past frames
-        in its own sequence and over features, of the squared difference
-        between the frame and :meth:`predict_next`'s prediction.  In the
-        units of ``X``, like :meth:`ConditionalRBM.score`, so a stack and a
-        single layer can be compared on the same held-out sequences (give
-        the single layer the same frames, e.g. by scoring both on sequences
-        longer than ``history_length``).
+        The stack generates a frame top-down (the top layer's conditional
+        distribution over the hidden units of the layer below, then each
+        layer's conditional down to the frame), so its likelihood sums over
+        the hidden units of every lower layer.  With their hidden
+        probabilities as the proposal (as in training), ten draws per frame
+        give the importance-weighted lower bound (Burda, Grosse &
+        Salakhutdinov, 2016; one draw would give the variational bound of
+        Hinton, Osindero & Teh, 2006), whose top term is the top layer's
+        exact or annealed log-likelihood (see
+        :meth:`ConditionalRBM.score_samples`).  It is low on average, so a
+        stack that scores above a single :class:`ConditionalRBM` is better
+        than it.  A one-layer stack gives its layer's
+        :meth:`~ConditionalRBM.score_samples`.  Frames with fewer than
+        :attr:`history_length` past frames in their sequence use edge
+        padding as :meth:`transform` does.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            All sequences stacked, each contiguous and in time order.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        log_likelihood : ndarray of shape (n_frames,)
+            The bound for each frame, in the dtype of the model.
+        """
+        X, sequences = self._check_inference_input(X, sequence_ids)
+        return self._log_likelihood(X, sequence_ids, sequences).astype(X.dtype)
+
+    def _log_likelihood(self, X, sequence_ids, sequences):
+        if len(self.layers_) == 1:
+            return self.layers_[0]._log_likelihood(X, sequences).log_likelihood
+        frames = np.arange(X.shape[0])
+        representations = self._representations(X, sequence_ids)
+        starts = sequences.frame_starts()
+        layers, biases = [], []
+        for layer, representation in zip(self.layers_, representations, strict=True):
+            params = _layer_params(layer, np.float64)
+            variance = getattr(layer, "visible_variance_", None)
+            layers.append((params, None if variance is None else np.sqrt(variance)))
+            history = frame_history(representation, frames, params.n_lags, starts)
+            biases.append(dynamic_biases(params, history))
+        top = self.layers_[-1]
+        return stack_log_likelihood_bound(
+            layers,
+            X[frames],
+            biases,
+            n_samples=_BOUND_SAMPLES,
+            rng=_rng_from(self.random_state),
+            method="auto",
+            n_steps=top.ais_steps,
+            n_chains=top.ais_chains,
+        )
+
+    def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
+        """Mean lower bound on the log-likelihood per frame, in nats.
+
+        The mean of :meth:`score_samples` over every frame with
+        :attr:`history_length` past frames in its own sequence.  On the same
+        frames it can be compared with :meth:`ConditionalRBM.score` (give
+        the single model the same frames, e.g. by scoring both on sequences
+        longer than ``history_length``): being a lower bound, a stack that
+        scores higher is better.  The one-step prediction error is
+        :func:`~sklearn_crbm.model_selection.make_prediction_scorer`.
 
         Parameters
         ----------
@@ -552,7 +614,7 @@ class StackedCRBM(
         Returns
         -------
         score : float
-            Negative mean squared one-step-ahead prediction error.
+            Mean log-likelihood bound per frame.
         """
         X, sequences = self._check_inference_input(X, sequence_ids)
         frames = sequences.valid_frames(self.history_length)
@@ -565,9 +627,9 @@ class StackedCRBM(
         weights = None
         if sample_weight is not None:
             weights = _check_sample_weight(sample_weight, X)[frames]
-        predicted = self._predict_frames(X, sequence_ids, sequences, frames)
-        errors = np.mean(np.square(X[frames] - predicted), axis=1)
-        return -float(np.average(errors, weights=weights))
+        # every frame, as score_samples draws them: the same random numbers
+        bound = self._log_likelihood(X, sequence_ids, sequences)[frames]
+        return float(np.average(bound, weights=weights))
 
     # ----------------------------------------------------------- generation
 
