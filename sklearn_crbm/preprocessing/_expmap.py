@@ -25,6 +25,7 @@ from ._layout import (
     check_encoded,
     expmap_layout,
     find_euler_blocks,
+    moving_root,
     skeleton_feature_names,
 )
 
@@ -75,10 +76,10 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         maps stay far from a rotation of pi, where they would jump, unless a
         bone turns more than pi away from its mean (with ``"rest"``, a joint
         that sits near pi from its rest pose, such as a thigh in some BVH
-        rigs, jumps back and forth).  The root (the skeleton's bones without
-        a parent; without a skeleton, the bone of the first Euler block) is
-        always measured from the rest pose, since :class:`RootRelativeEncoder`
-        reads its global orientation.
+        rigs, jumps back and forth).  The root is always measured from the
+        rest pose, since :class:`RootRelativeEncoder` reads its global
+        orientation: the first bone whose translation channels (``tx``,
+        ``ty``, ``tz``) move in the data, as in :class:`RootRelativeEncoder`.
 
     Attributes
     ----------
@@ -208,19 +209,14 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         self.encoded_bones_ = [b.bone for b in self._blocks]
         return self
 
-    def _root_bones(self):
-        if self.skeleton is not None:
-            return {b.name for b in self.skeleton.bones if b.parent is None}
-        return {self._blocks[0].bone} if self._blocks else set()
-
     def _fit_references(self, X):
         """Each block's reference rotation: identity, or the bone's mean rotation."""
         references = np.broadcast_to(np.eye(3), (len(self._blocks), 3, 3)).copy()
         if self.reference == "rest":
             return references
-        roots = self._root_bones()
+        root = moving_root(self._names_in, X, self.skeleton)
         for i, block in enumerate(self._blocks):
-            if block.bone not in roots:
+            if block.bone != root:
                 R = euler_to_matrix(X[:, list(block.columns)] * self._scale(), block.axes)
                 references[i] = mean_rotation(R)
         return references

@@ -19,7 +19,12 @@ from ..utils._rotations import (
     matrix_to_expmap,
 )
 from ..utils._sequences import check_sequence_ids
-from ._layout import check_encoded, check_skeleton, expmap_feature_names
+from ._layout import (
+    check_encoded,
+    check_skeleton,
+    expmap_feature_names,
+    moving_root,
+)
 
 __all__ = ["RootRelativeEncoder"]
 
@@ -97,8 +102,11 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         axis (the round trip stays exact, but heading is then ill-defined).
     root : str or None, default=None
         Name of the root bone: the encoder reads ``"{root}_tx"``, ... and
-        writes ``"{root}_pitch"``, ....  None takes the skeleton's root (its
-        first bone), or ``"root"`` without a skeleton.
+        writes ``"{root}_pitch"``, ....  None takes the first bone whose
+        translation channels move in the data seen in :meth:`fit`: the
+        skeleton's root (its first bone), except in rigs that put a static
+        bone above the moving pelvis (the Bandai Namco files: ``joint_Root``
+        above ``Hips``); ``"root"`` for a plain array without a skeleton.
     roll : {"euler", "taylor"}, default="euler"
         ``"euler"`` gives every orientation, upside down included, an exact
         inverse.  ``"taylor"`` reproduces Taylor's ``preprocess1`` (the
@@ -108,6 +116,8 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
 
     Attributes
     ----------
+    root_ : str
+        Name of the root bone used.
     root_columns_ : ndarray of shape (6,)
         Input columns of ``tx, ty, tz, ex, ey, ez``.
     up_axis_ : str
@@ -181,12 +191,14 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         self.root = root
         self.roll = roll
 
-    def _root_name(self):
+    def _root_name(self, names, X):
         if self.root is not None:
             return self.root
+        if names is None:
+            return "root"
         if self.skeleton is not None:
-            return check_skeleton(self.skeleton).bones[0].name
-        return "root"
+            check_skeleton(self.skeleton)
+        return moving_root(names, X, self.skeleton) or "root"
 
     def _layout_names(self, n_features):
         if hasattr(self, "feature_names_in_"):
@@ -230,8 +242,8 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         if up not in _AXES:
             raise ValueError(f"up_axis must be 'x', 'y' or 'z', got {up!r}.")
         self.up_axis_ = up
-        root = self._root_name()
         names = self._layout_names(X.shape[1])
+        root = self._root_name(names, X)
         wanted = [f"{root}_{c}" for c in _ROOT_IN]
         if names is None:
             if X.shape[1] < 6:
@@ -304,7 +316,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
                 else "Pass up_axis= to name the vertical axis."
             ),
             UserWarning,
-            stacklevel=3,
+            stacklevel=4,
         )
 
     def _local_rotations(self, expmaps):
@@ -414,7 +426,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
                 "horizon, and inverse_transform will return those frames mirrored. "
                 "Use roll='euler' (the default) for an exact round trip.",
                 UserWarning,
-                stacklevel=3,
+                stacklevel=4,
             )
         return pitch, roll, heading
 

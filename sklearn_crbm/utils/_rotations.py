@@ -389,8 +389,10 @@ def mean_rotation(R):
     >>> import numpy as np
     >>> from sklearn_crbm.utils._rotations import euler_to_matrix, mean_rotation
     >>> R = euler_to_matrix(np.deg2rad([[170.0], [-170.0]]), "x")
-    >>> np.rad2deg(np.arctan2(*mean_rotation(R)[[2, 1], 1])).round(6) + 0.0
-    180.0
+    >>> mean_rotation(R).round(12) + 0.0  # 180 degrees about x
+    array([[ 1.,  0.,  0.],
+           [ 0., -1.,  0.],
+           [ 0.,  0., -1.]])
     """
     R = np.asarray(R, dtype=np.float64)
     if R.ndim != 3 or R.shape[1:] != (3, 3):
