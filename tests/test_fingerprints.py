@@ -13,6 +13,7 @@ a deliberate change of the math or of a random stream may rewrite the file,
 and its commit must say which entries changed and why.
 """
 
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -99,9 +100,7 @@ def _crbm_results():
 def _imputer_results():
     out = {}
     for dtype in ("float64", "float32"):
-        model = ConditionalRBM(
-            8, order=2, n_iter=10, history_noise=0.3, random_state=0
-        )
+        model = ConditionalRBM(8, order=2, n_iter=10, history_noise=0.3, random_state=0)
         train = X[IDS < 3].astype(dtype)
         for particles in (1, 3):
             imputer = CRBMImputer(
@@ -123,7 +122,10 @@ def _stacked_results():
     for dtype in ("float64", "float32"):
         for orders in ((1, None), (2, 1)):
             stack = StackedCRBM(
-                (8, 4), order=orders[0], hidden_order=orders[1], n_iter=5,
+                (8, 4),
+                order=orders[0],
+                hidden_order=orders[1],
+                n_iter=5,
                 random_state=0,
             ).fit(X.astype(dtype), sequence_ids=IDS)
             key = f"order{orders[0]}_{orders[1]}.{dtype}"
@@ -153,6 +155,7 @@ def results():
     return compute()
 
 
+@functools.cache
 def _pinned():
     with np.load(PATH) as data:
         return dict(data)
