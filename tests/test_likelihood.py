@@ -191,15 +191,8 @@ def test_reverse_and_forward_estimates_bracket_the_exact_value(
 def test_ais_is_unbiased_for_the_partition_function():
     """Many chains: log of the mean weight converges on the exact log Z."""
     rng = np.random.default_rng(0)
-    params = CRBMParameters(
-        rng.standard_normal((8, 4)),
-        np.zeros(8),
-        np.zeros(4),
-        np.zeros((12, 0)),
-        0,
-        0,
-        "gaussian",
-    )
+    params = CRBMParameters(4, 8, 0, 0, "gaussian", np.float64)
+    params.weights[...] = rng.standard_normal((8, 4))
     rbms = FrameRBMs(
         params, rng.standard_normal((3, 4)), rng.standard_normal((3, 8)), [0.5, 1, 1, 2]
     )

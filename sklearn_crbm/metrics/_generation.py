@@ -14,10 +14,12 @@ import numpy as np
 from scipy.signal import welch
 from sklearn.utils import check_array
 
+from ..datasets import bone_columns
 from ..utils._sequences import check_sequence_ids
 
 __all__ = [
     "forward_speed",
+    "gait_statistics",
     "motion_amplitude",
     "nearest_style",
     "spectral_similarity",
@@ -80,6 +82,23 @@ def _columns(features, names, n_features):
     return np.asarray(columns, dtype=np.intp)
 
 
+def _forward_feature(names):
+    """The one feature named ``"{root}_dforward"``, or a ValueError."""
+    if names is None:
+        raise ValueError(
+            "forward_speed needs the forward-displacement channel: pass feature= "
+            "(its name or column index), or feature_names=... or a DataFrame with "
+            "a column named '{root}_dforward' (RootRelativeEncoder's output)."
+        )
+    found = [str(n) for n in names if str(n).endswith("_dforward")]
+    if len(found) != 1:
+        raise ValueError(
+            f"forward_speed found {len(found)} features named '{{root}}_dforward' "
+            f"({found}); pass feature= to choose the forward-displacement channel."
+        )
+    return found[0]
+
+
 def _check_last_frames(last_frames):
     if last_frames is None:
         return None
@@ -115,7 +134,7 @@ def forward_speed(
     X,
     *,
     sequence_ids=None,
-    feature="root_dforward",
+    feature=None,
     feature_names=None,
     last_frames=None,
 ):
@@ -123,7 +142,8 @@ def forward_speed(
 
     The mean over the frames of each sequence of the channel that holds the
     body's forward displacement from one frame to the next (``root_dforward``
-    of :class:`~sklearn_crbm.preprocessing.RootRelativeEncoder`).  Pass the
+    of :class:`~sklearn_crbm.preprocessing.RootRelativeEncoder`, named
+    ``"{root}_dforward"`` after the skeleton's root bone).  Pass the
     motion in the encoder's units (undo the standard scaling first) to get
     length units per frame; standardised motion gives the same ranking.
 
@@ -133,8 +153,11 @@ def forward_speed(
         Motion, all sequences stacked in long format.
     sequence_ids : array-like of shape (n_frames,), default=None
         Sequence id of every frame; ``None`` means one sequence.
-    feature : str or int, default="root_dforward"
-        The forward-displacement channel, by name or column index.
+    feature : str or int or None, default=None
+        The forward-displacement channel, by name or column index.  None
+        takes the one feature whose name ends in ``"_dforward"``
+        (``root_dforward`` for CMU data, ``Hips_dforward`` for a root called
+        ``Hips``).
     feature_names : array-like of str, default=None
         Names of the columns of ``X``; default the columns of a DataFrame.
     last_frames : int, default=None
@@ -157,6 +180,8 @@ def forward_speed(
     array([0.7, 2.2])
     """
     X, sequences, names = _check_motion(X, sequence_ids, feature_names)
+    if feature is None:
+        feature = _forward_feature(names)
     columns = _columns(feature, names, X.shape[1])
     if len(columns) != 1:
         raise ValueError("forward_speed needs exactly one feature.")
@@ -289,6 +314,100 @@ def step_frequency(
         power[grid < frame_rate / n_frames] = -1.0
         frequencies.append(float(grid[np.argmax(power)]))
     return np.asarray(frequencies)
+
+
+def gait_statistics(
+    X,
+    *,
+    sequence_ids=None,
+    feature_names=None,
+    legs=("lfemur", "rfemur", "ltibia", "rtibia"),
+    speed_feature="root_dforward",
+    frame_rate=30.0,
+    last_frames=None,
+):
+    """Forward speed and gait frequency of each sequence: what tells a walk from a jog.
+
+    Column 0 is :func:`forward_speed` of ``speed_feature``, column 1 the
+    :func:`step_frequency` of every channel of the ``legs`` bones (hips and
+    knees by default).  Pass the rows of generated sequences and of
+    training sequences of known style to :func:`nearest_style` to classify
+    the generated ones, as the command line's demo and the generation
+    benchmarks do.
+
+    Parameters
+    ----------
+    X : array-like of shape (n_frames, n_features)
+        Motion after preprocessing (exponential maps, body-centred root),
+        all sequences stacked in long format.
+    sequence_ids : array-like of shape (n_frames,), default=None
+        Sequence id of every frame; ``None`` means one sequence.
+    feature_names : array-like of str, default=None
+        Names of the columns of ``X`` (``"{bone}_{channel}"``); default the
+        columns of a DataFrame.
+    legs : sequence of str, default=("lfemur", "rfemur", "ltibia", "rtibia")
+        Bones whose channels give the gait cycle: the CMU names of the hips
+        and knees.  Name those of another skeleton here (Taylor's MIT data:
+        ``("lhip", "rhip", "lknee", "rknee")``).
+    speed_feature : str, default="root_dforward"
+        The forward-displacement channel.
+    frame_rate : float, default=30.0
+        Frames per second.
+    last_frames : int, default=None
+        Use only the last ``last_frames`` frames of each sequence.
+
+    Returns
+    -------
+    statistics : ndarray of shape (n_sequences, 2)
+        Forward speed (units of ``X`` per frame) and gait frequency (Hz) of
+        every sequence.
+
+    Raises
+    ------
+    ValueError
+        If a bone of ``legs`` or ``speed_feature`` has no column; the
+        message names it.
+
+    See Also
+    --------
+    nearest_style : Classify sequences by these statistics.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn_crbm.metrics import gait_statistics, nearest_style
+    >>> t = np.arange(120)
+    >>> def trial(speed, period):
+    ...     swing = np.sin(2 * np.pi * t / period)
+    ...     return np.column_stack([np.full(120, speed), swing, -swing])
+    >>> names = ["root_dforward", "lfemur_ex", "rfemur_ex"]
+    >>> X = np.vstack([trial(0.7, 30), trial(2.0, 21), trial(0.8, 27)])
+    >>> ids = np.repeat([0, 1, 2], 120)
+    >>> stats = gait_statistics(X, sequence_ids=ids, feature_names=names,
+    ...                         legs=["lfemur", "rfemur"])
+    >>> stats.round(1)
+    array([[0.7, 1. ],
+           [2. , 1.4],
+           [0.8, 1.1]])
+    >>> nearest_style(stats[2:], stats[:2], ["walk", "jog"])
+    array(['walk'], dtype=object)
+    """
+    X, _, names = _check_motion(X, sequence_ids, feature_names)
+    if names is None:
+        raise ValueError(
+            "gait_statistics finds the legs and the speed channel by name: pass "
+            "feature_names=... (e.g. preprocessor.get_feature_names_out()) or a "
+            "DataFrame."
+        )
+    common = dict(sequence_ids=sequence_ids, last_frames=last_frames)
+    return np.column_stack(
+        [
+            forward_speed(X, feature=speed_feature, feature_names=names, **common),
+            step_frequency(
+                X, features=bone_columns(names, legs), frame_rate=frame_rate, **common
+            ),
+        ]
+    )
 
 
 def _spectra(X, sequences, columns, n_fft, last_frames=None):

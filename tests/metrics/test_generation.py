@@ -6,6 +6,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from sklearn_crbm.metrics import (
     forward_speed,
+    gait_statistics,
     motion_amplitude,
     nearest_style,
     spectral_similarity,
@@ -41,6 +42,19 @@ def test_forward_speed_is_the_per_sequence_mean_of_the_named_channel():
     # only the last frames
     X[140:150, 0] = 5.0
     assert forward_speed(X, sequence_ids=ids, feature=0, last_frames=10)[0] == 5.0
+
+
+def test_forward_speed_finds_the_channel_of_any_root():
+    X = np.vstack([gait(30, speed=0.7), gait(21, speed=2.0)])
+    ids = np.repeat([0, 1], 150)
+    hips = NAMES.copy()
+    hips[0] = "Hips_dforward"
+    assert_allclose(
+        forward_speed(X, sequence_ids=ids, feature_names=hips), [0.7, 2.0], atol=0.01
+    )
+    two = np.array(["Hips_dforward", "root_dforward", "a", "b"], dtype=object)
+    with pytest.raises(ValueError, match=r"found 2 .*Hips_dforward.*feature="):
+        forward_speed(X, feature_names=two)
 
 
 @pytest.mark.parametrize("period", [20, 30, 45])
@@ -139,3 +153,31 @@ def test_bad_feature_selection_is_an_error():
         step_frequency(X, frame_rate=0)
     with pytest.raises(ValueError, match="exactly one"):
         forward_speed(X, feature=[0, 1])
+
+
+def test_gait_statistics_are_speed_and_leg_frequency_and_classify_styles():
+    X = np.vstack([gait(30, speed=0.7), gait(21, speed=2.0), gait(28, speed=0.8)])
+    ids = np.repeat([0, 1, 2], 150)
+    stats = gait_statistics(
+        X, sequence_ids=ids, feature_names=NAMES, legs=["lfemur", "rfemur", "ltibia"]
+    )
+    assert stats.shape == (3, 2)
+    assert_array_equal(stats[:, 0], forward_speed(X, sequence_ids=ids, feature=0))
+    assert_array_equal(
+        stats[:, 1], step_frequency(X, sequence_ids=ids, features=[1, 2, 3])
+    )
+    assert_array_equal(
+        nearest_style(stats[2:], stats[:2], ["walk", "jog"]), np.array(["walk"])
+    )
+
+
+def test_gait_statistics_name_the_missing_bone_and_need_names():
+    X = gait(30)
+    with pytest.raises(ValueError, match="No column belongs to bone 'rtibia'"):
+        gait_statistics(X, feature_names=NAMES)  # the CMU default legs
+    with pytest.raises(ValueError, match="feature_names"):
+        gait_statistics(X, legs=["lfemur"])
+    with pytest.raises(ValueError, match="No feature is named 'pelvis_dforward'"):
+        gait_statistics(
+            X, feature_names=NAMES, legs=["lfemur"], speed_feature="pelvis_dforward"
+        )
