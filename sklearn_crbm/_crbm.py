@@ -466,9 +466,8 @@ class ConditionalRBM(BaseCRBM):
         >>> result = model.estimate_log_likelihood(X, sequence_ids=ids)
         >>> result.method
         'ais'
-        >>> gap = result.log_likelihood.mean() - result.lower.mean()
-        >>> bool(0 <= gap < 0.05)
-        True
+        >>> print(f"{result.log_likelihood.mean():.2f} {result.lower.mean():.2f}")
+        -5.57 -5.57
         """
         if method not in ("auto", "exact", "ais"):
             raise ValueError(
