@@ -1,7 +1,7 @@
 """Conditional Restricted Boltzmann Machine (Taylor, Hinton & Roweis, 2006)."""
 
 import time
-from numbers import Integral
+from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import _fit_context
@@ -24,6 +24,7 @@ from .utils._sequences import (
     check_sequence_ids,
     frame_history,
     shuffled_batches,
+    validation_split,
 )
 
 
@@ -106,6 +107,24 @@ class ConditionalRBM(BaseCRBM):
     ais_chains : int, default=2
         Annealing chains per frame (per starting frame for a model without
         history).
+    early_stopping : bool, default=False
+        Hold out whole sequences (``validation_fraction`` of the frames) in
+        :meth:`fit`, score them (:meth:`score`, the held-out
+        log-likelihood) every ``validation_interval`` epochs, stop when it
+        has not improved by ``tol`` for ``n_iter_no_change`` epochs (or
+        after ``n_iter``), and keep the parameters that scored best.
+        Needs several sequences; ignored by :meth:`partial_fit`.
+    validation_fraction : float, default=0.1
+        Fraction of the frames, in whole sequences drawn at random, held
+        out when ``early_stopping`` is True.
+    n_iter_no_change : int, default=50
+        Epochs without an improvement of ``tol`` after which
+        ``early_stopping`` stops training.
+    validation_interval : int, default=10
+        Epochs between two validation scores when ``early_stopping``.
+    tol : float, default=1e-3
+        Improvement of the validation score, in nats per frame, that counts
+        when ``early_stopping``.
     random_state : int, RandomState instance or None, default=None
         Controls initialisation, minibatches, sampling during training and,
         unless ``sample`` is given its own, generation.  Pass an int for
@@ -138,6 +157,12 @@ class ConditionalRBM(BaseCRBM):
         Random generator state carried across :meth:`partial_fit` calls.
     n_iter_ : int
         Number of epochs trained so far.
+    validation_scores_ : list of float
+        With ``early_stopping``: the held-out score after every
+        ``validation_interval`` epochs.
+    best_validation_score_ : float
+        With ``early_stopping``: the best of them, that of the parameters
+        kept.
     n_features_in_ : int
         Number of features seen during :term:`fit`.
     feature_names_in_ : ndarray of shape (`n_features_in_`,)
@@ -183,6 +208,11 @@ class ConditionalRBM(BaseCRBM):
         "visible_type": [StrOptions({"gaussian", "binary"})],
         "ais_steps": [Interval(Integral, 1, None, closed="left")],
         "ais_chains": [Interval(Integral, 1, None, closed="left")],
+        "early_stopping": ["boolean"],
+        "validation_fraction": [Interval(Real, 0, 1, closed="neither")],
+        "n_iter_no_change": [Interval(Integral, 1, None, closed="left")],
+        "validation_interval": [Interval(Integral, 1, None, closed="left")],
+        "tol": [Interval(Real, 0, None, closed="left")],
     }
 
     # Private state that a failed fit must forget with the fitted attributes:
@@ -213,6 +243,11 @@ class ConditionalRBM(BaseCRBM):
         n_iter=200,
         ais_steps=50,
         ais_chains=2,
+        early_stopping=False,
+        validation_fraction=0.1,
+        n_iter_no_change=50,
+        validation_interval=10,
+        tol=1e-3,
         random_state=None,
         verbose=0,
     ):
@@ -231,6 +266,11 @@ class ConditionalRBM(BaseCRBM):
         self.n_iter = n_iter
         self.ais_steps = ais_steps
         self.ais_chains = ais_chains
+        self.early_stopping = early_stopping
+        self.validation_fraction = validation_fraction
+        self.n_iter_no_change = n_iter_no_change
+        self.validation_interval = validation_interval
+        self.tol = tol
         self.random_state = random_state
         self.verbose = verbose
 
@@ -259,7 +299,10 @@ class ConditionalRBM(BaseCRBM):
             sequences, frames = self._check_sequences(X, sequence_ids)
             self.random_state_ = check_random_state(self.random_state)
             self._initialize(X.shape[1], X.dtype)
-            self._train(X, frames, self.n_iter)
+            if self.early_stopping:
+                self._train_with_early_stopping(X, sequences)
+            else:
+                self._train(X, frames, self.n_iter)
             self.seed_windows_ = self._pick_seed_windows(X, sequences)
         return self
 
@@ -414,6 +457,44 @@ class ConditionalRBM(BaseCRBM):
                     f"time = {time.perf_counter() - start:.2f}s"
                 )
         self._parameters = params.copy(layout="C")
+
+    def _train_with_early_stopping(self, X, sequences):
+        """Train on some sequences, keep the parameters that score best on the rest."""
+        rng = rng_from(self.random_state_)
+        held = validation_split(sequences, self.validation_fraction, rng)
+        ids = sequences.per_frame_ids()
+        parts = []
+        for mask in (~held, held):
+            part = check_sequence_ids(ids[mask], int(mask.sum()))
+            frames = part.valid_frames(self._n_lags)
+            if len(frames) == 0:
+                raise ValueError(
+                    f"early_stopping: no {'validation' if mask is held else 'training'}"
+                    f" frame has {self._n_lags} past frames in its sequence; pass "
+                    "longer sequences or raise validation_fraction."
+                )
+            parts.append((X[mask], part, frames))
+        (X_train, _, train_frames), (X_valid, valid, valid_frames) = parts
+        # the same random numbers at every check: changes are the model's
+        seed = int(rng.integers(np.iinfo(np.int32).max))
+        self.validation_scores_ = []
+        best, best_iter, best_parameters = -np.inf, 0, None
+        while self.n_iter_ < self.n_iter:
+            epochs = min(self.validation_interval, self.n_iter - self.n_iter_)
+            self._train(X_train, train_frames, epochs)
+            score = (
+                self._log_likelihood(X_valid, valid, rng=np.random.default_rng(seed))
+                .log_likelihood[valid_frames]
+                .mean()
+            )
+            self.validation_scores_.append(float(score))
+            if score > best + self.tol or best_parameters is None:
+                best, best_iter = float(score), self.n_iter_
+                best_parameters = self._parameters.copy()
+            elif self.n_iter_ - best_iter >= self.n_iter_no_change:
+                break
+        self._parameters = best_parameters
+        self.best_validation_score_ = best
 
     def estimate_log_likelihood(
         self, X, *, sequence_ids=None, method="auto", reverse=True, random_state=None

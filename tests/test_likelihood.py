@@ -254,3 +254,36 @@ def test_held_out_score_ranks_orders_and_sizes():
         ).fit(X[train], sequence_ids=ids[train])
         scores[order] = model.score(X[test], sequence_ids=ids[test])
     assert scores[2] > scores[0] + 1.0
+
+
+# ------------------------------------------------------------ early stopping
+def test_early_stopping_keeps_the_parameters_that_score_best():
+    X = frames(400, 5)
+    ids = np.repeat(np.arange(10), 40)
+    params = dict(
+        n_components=12,
+        order=2,
+        learning_rate=0.01,
+        n_iter=400,
+        early_stopping=True,
+        validation_fraction=0.2,
+        validation_interval=5,
+        n_iter_no_change=20,
+        random_state=0,
+    )
+    model = ConditionalRBM(**params).fit(X, sequence_ids=ids)
+    scores = model.validation_scores_
+    assert model.n_iter_ < 400  # it stopped
+    assert len(scores) == int(np.ceil(model.n_iter_ / 5))
+    assert model.best_validation_score_ >= max(scores) - model.tol
+    assert model.best_validation_score_ in scores
+    # the kept parameters are those of the best check, not the last
+    again = ConditionalRBM(**params).fit(X, sequence_ids=ids)
+    assert_allclose(again.components_, model.components_)
+    assert again.validation_scores_ == scores
+
+
+def test_early_stopping_needs_several_sequences():
+    model = ConditionalRBM(4, order=1, early_stopping=True, n_iter=5)
+    with pytest.raises(ValueError, match="single sequence"):
+        model.fit(frames(50, 3))
