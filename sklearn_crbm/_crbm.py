@@ -39,6 +39,7 @@ from .utils._sequences import (
     frame_history,
     shuffled_batches,
 )
+from .utils._threads import batch_rows, frame_rows, limit_blas_threads, sequence_rows
 
 # Frames processed at once by transform / score: bounds the gathered history.
 _CHUNK_FRAMES = 4096
@@ -268,6 +269,7 @@ class ConditionalRBM(
 
     # ------------------------------------------------------------------ fit
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None, *, sequence_ids=None):
         """Train the model on sequences of frames.
@@ -295,6 +297,7 @@ class ConditionalRBM(
             self.seed_windows_ = self._pick_seed_windows(X, sequences)
         return self
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def partial_fit(self, X, y=None, *, sequence_ids=None):
         """Train for one epoch on the given sequences, keeping the current state.
@@ -522,6 +525,7 @@ class ConditionalRBM(
             )
             yield (rows, *dynamic_biases(params, history))
 
+    @limit_blas_threads(frame_rows)
     def transform(self, X, *, sequence_ids=None):
         """Hidden probabilities ``p(h = 1 | x_t, history)`` of every frame.
 
@@ -548,6 +552,7 @@ class ConditionalRBM(
             hidden[rows] = hidden_probabilities(params, X[rows], hidden_bias)
         return hidden
 
+    @limit_blas_threads(frame_rows)
     def score_samples(self, X, *, sequence_ids=None):
         """Negative free energy ``-F(x_t | history)`` of every frame.
 
@@ -579,6 +584,7 @@ class ConditionalRBM(
             scores[rows] = -free_energy(params, X[rows], visible_bias, hidden_bias)
         return scores
 
+    @limit_blas_threads(frame_rows)
     def predict_next(self, X, *, sequence_ids=None):
         """One-step-ahead prediction of every frame from its history alone.
 
@@ -617,6 +623,7 @@ class ConditionalRBM(
             position += len(rows)
         return predicted
 
+    @limit_blas_threads(frame_rows)
     def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
         """Negative one-step-ahead prediction error; higher is better.
 
@@ -663,6 +670,7 @@ class ConditionalRBM(
 
     # ----------------------------------------------------------- generation
 
+    @limit_blas_threads(sequence_rows)
     def sample(
         self,
         n_samples,

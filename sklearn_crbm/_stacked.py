@@ -32,6 +32,7 @@ from ._crbm_math import (
 )
 from .utils._persistence import VersionedPickleMixin
 from .utils._sequences import check_sequence_ids, frame_history
+from .utils._threads import batch_rows, frame_rows, limit_blas_threads, sequence_rows
 
 __all__ = ["StackedCRBM"]
 
@@ -317,6 +318,7 @@ class StackedCRBM(
 
     # ------------------------------------------------------------------ fit
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None, *, sequence_ids=None):
         """Train the layers greedily, bottom first.
@@ -354,6 +356,7 @@ class StackedCRBM(
         self.seed_windows_ = self._pick_seed_windows(X, sequences)
         return self
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def partial_fit(self, X, y=None, *, sequence_ids=None):
         """Train every layer for one epoch on the given sequences.
@@ -452,6 +455,7 @@ class StackedCRBM(
             )
         return representations
 
+    @limit_blas_threads(frame_rows)
     def transform(self, X, *, sequence_ids=None):
         """Top-layer hidden probabilities of every frame.
 
@@ -480,6 +484,7 @@ class StackedCRBM(
             representations[-1], sequence_ids=sequence_ids
         )
 
+    @limit_blas_threads(frame_rows)
     def predict_next(self, X, *, sequence_ids=None):
         """One-step-ahead prediction of every frame through the whole stack.
 
@@ -526,6 +531,7 @@ class StackedCRBM(
             predicted = visible_means(p, predicted, visible_bias)
         return predicted
 
+    @limit_blas_threads(frame_rows)
     def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
         """Negative one-step-ahead prediction error of the stack; higher is better.
 
@@ -571,6 +577,7 @@ class StackedCRBM(
 
     # ----------------------------------------------------------- generation
 
+    @limit_blas_threads(sequence_rows)
     def sample(
         self,
         n_samples,

@@ -27,6 +27,7 @@ from ..utils._fitting import unfitted_on_error
 from ..utils._parallel import map_sequence_blocks
 from ..utils._persistence import VersionedPickleMixin
 from ..utils._sequences import Sequences, check_sequence_ids
+from ..utils._threads import chain_rows, limit_blas_threads
 from ._base import check_imputer_input, complete_runs
 
 # Rounds of "fill, then use the fill as its own past" for the first frame of a
@@ -289,6 +290,7 @@ class CRBMImputer(
             X, sequence_ids=sequence_ids
         )
 
+    @limit_blas_threads(chain_rows)
     def transform(self, X, *, sequence_ids=None):
         """Fill every missing value of ``X`` on-line.
 
@@ -308,6 +310,7 @@ class CRBMImputer(
         """
         return self._impute(X, sequence_ids, self.n_draws, self.random_state, True)
 
+    @limit_blas_threads(chain_rows)
     def sample(self, X, n_samples=1, *, sequence_ids=None, random_state=None):
         """Draw independent on-line fills of ``X`` (multiple imputation).
 
