@@ -425,6 +425,9 @@ class ConditionalRBM(
         self.autoregressive_ = params.autoregressive()
         self.past_to_hidden_ = params.past_to_hidden()
 
+    # Diverging weights overflow in the products before the epoch's check
+    # raises TrainingDivergedError, which says what to do.
+    @np.errstate(over="ignore", invalid="ignore")
     def _train(self, X, frames, n_epochs):
         params = self._params()
         # params' arrays become views of one buffer, updated in place
