@@ -18,6 +18,7 @@ import numpy as np
 from threadpoolctl import ThreadpoolController
 
 from .._config import get_config
+from .._crbm_math import CHUNK_FRAMES
 from ._parallel import BLOCK_SEQUENCES
 
 __all__ = [
@@ -35,11 +36,6 @@ __all__ = [
 # 5e6 (batch 100 x 200 hidden x 62 x 4 inputs); batch 1000 with 1000 hidden
 # units and 400 inputs (4e8) gets four threads where four cores are allowed.
 MIN_WORK_PER_THREAD = 10**8
-
-# Most frames and sequences the estimators put in one product: the chunks of
-# ConditionalRBM's inference and the blocks of its ``sample``.
-_FRAME_CHUNK = 4096
-_SEQUENCE_BLOCK = 256
 
 _controller = None
 # The BLAS thread count is one setting of the whole process.  The first of
@@ -163,14 +159,16 @@ def batch_rows(estimator, *args, **kwargs):
 
 def frame_rows(estimator, X, *args, **kwargs):
     """Inference on every frame: up to one chunk of frames."""
-    return min(len(X), _FRAME_CHUNK)
+    return min(len(X), CHUNK_FRAMES)
 
 
 def sequence_rows(estimator, n_samples, *, history=None, n_sequences=1, **kwargs):
     """Generation: the sequences generated together."""
+    from .._base import SAMPLE_BLOCK  # _base imports this module
+
     if history is not None and np.ndim(history) == 3:
         n_sequences = len(history)
-    return min(int(n_sequences), _SEQUENCE_BLOCK)
+    return min(int(n_sequences), SAMPLE_BLOCK)
 
 
 def chain_rows(estimator, X, n_samples=None, *, sequence_ids=None, **kwargs):
