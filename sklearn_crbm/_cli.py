@@ -271,7 +271,7 @@ def _generate_styles(model, Z, train, names, args):
         seeds = random_windows(
             Z,
             sequence_ids=ids,
-            width=model.order,
+            width=max(model.history_length, 1),
             n_windows=3,
             sequences=np.flatnonzero(reference_styles == style),
             random_state=rng,
@@ -411,7 +411,7 @@ def run_sample(args):
     seeds = random_windows(
         Z,
         sequence_ids=train.sequence_ids,
-        width=max(crbm.order, crbm.hidden_order or crbm.order, 1),
+        width=max(crbm.history_length, 1),
         n_windows=args.n_sequences,
         sequences=np.flatnonzero(np.asarray(train.motion) == args.style),
         random_state=args.seed,
