@@ -82,7 +82,8 @@ def test_cmu_gives_the_papers_62_dimensions(cmu):
 
 
 def test_mit_gives_49_dimensions_equal_to_the_tsbn_file(mit, data_home):
-    pre = make_motion_preprocessor(mit.skeleton)
+    # the paper's encoding: rotations from the rest pose, Taylor's roll
+    pre = make_motion_preprocessor(mit.skeleton, reference="rest", roll="taylor")
     Z = pre.fit_transform(mit.data, sequence_ids=mit.sequence_ids)
     assert Z.shape == (3826, 49)
     tsbn = scipy.io.loadmat(data_home / "mit_tsbn" / "mit_mocap.mat")
