@@ -207,12 +207,15 @@ def run_demo(args):
         f"{', '.join(test.sequence_names)}"
     )
 
-    preprocessor = make_motion_preprocessor(train.skeleton)
+    # the paper's encoding: joint rotations from the rest pose, Taylor's roll
+    preprocessor = make_motion_preprocessor(
+        train.skeleton, reference="rest", roll="taylor"
+    )
     Z = preprocessor.fit_transform(train.data, sequence_ids=train.sequence_ids)
     names = preprocessor.get_feature_names_out()
     print(
         f"preprocessed to {Z.shape[1]} dimensions "
-        "(exp maps, body-centred root, z-scores)"
+        "(exp maps, body-centred root, z-scores; the paper's encoding)"
     )
 
     model = _model_from_args(args)
