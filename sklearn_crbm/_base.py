@@ -31,6 +31,7 @@ from .utils._parallel import map_sequence_blocks
 from .utils._persistence import VersionedPickleMixin
 from .utils._random import rng_from
 from .utils._sequences import check_sequence_ids
+from .utils._threads import frame_rows, limit_blas_threads, sequence_rows
 
 __all__ = ["BaseCRBM", "check_count", "seed_frames"]
 
@@ -178,6 +179,7 @@ class BaseCRBM(
             )
         return representations
 
+    @limit_blas_threads(frame_rows)
     def transform(self, X, *, sequence_ids=None):
         """Hidden probabilities of the top layer, frame by frame.
 
@@ -204,6 +206,7 @@ class BaseCRBM(
         X, sequences = self._check_inference_input(X, sequence_ids)
         return self._representations(X, sequences, self._layer_parameters())[-1]
 
+    @limit_blas_threads(frame_rows)
     def predict_next(self, X, *, sequence_ids=None):
         """One-step-ahead prediction of every frame from its history alone.
 
@@ -256,6 +259,7 @@ class BaseCRBM(
             position += len(rows)
         return predicted
 
+    @limit_blas_threads(frame_rows)
     def score_samples(self, X, *, sequence_ids=None):
         """Conditional log-likelihood ``log p(x_t | history)`` of every frame, in nats.
 
@@ -353,6 +357,7 @@ class BaseCRBM(
         bound = np.concatenate(bounds)
         return LogLikelihood(bound, None, np.zeros_like(bound), "bound")
 
+    @limit_blas_threads(frame_rows)
     def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
         """Mean held-out log-likelihood per frame, in nats; higher is better.
 
@@ -401,6 +406,7 @@ class BaseCRBM(
 
     # ----------------------------------------------------------- generation
 
+    @limit_blas_threads(sequence_rows)
     def sample(
         self,
         n_samples,

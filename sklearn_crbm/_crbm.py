@@ -26,6 +26,7 @@ from .utils._sequences import (
     shuffled_batches,
     validation_split,
 )
+from .utils._threads import batch_rows, frame_rows, limit_blas_threads
 
 
 class TrainingDivergedError(FloatingPointError):
@@ -146,7 +147,9 @@ class ConditionalRBM(BaseCRBM):
         frame ``t``.
     past_to_hidden_ : ndarray of shape (hidden_order, n_components, n_features)
         ``past_to_hidden_[q - 1] @ x[t - q]`` adds to the hidden input of
-        frame ``t``.
+        frame ``t``.  This and the four attributes above are views of one
+        packed parameter buffer; assigning an array of the same shape to
+        one of them changes the model.
     seed_windows_ : ndarray of shape (n_windows, width, n_features)
         ``width = max(order, hidden_order, 1)``. Windows of consecutive
         training frames kept to seed :meth:`sample`.
@@ -276,6 +279,7 @@ class ConditionalRBM(BaseCRBM):
 
     # ------------------------------------------------------------------ fit
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None, *, sequence_ids=None):
         """Train the model on sequences of frames.
@@ -306,6 +310,7 @@ class ConditionalRBM(BaseCRBM):
             self.seed_windows_ = self._pick_seed_windows(X, sequences)
         return self
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def partial_fit(self, X, y=None, *, sequence_ids=None):
         """Train for one epoch on the given sequences, keeping the current state.
@@ -397,6 +402,9 @@ class ConditionalRBM(BaseCRBM):
         self._parameters = params
         self._velocity = params.zeros_like(layout="F")
 
+    # Diverging weights overflow in the products before the epoch's check
+    # raises TrainingDivergedError, which says what to do.
+    @np.errstate(over="ignore", invalid="ignore")
     def _train(self, X, frames, n_epochs):
         # trained in the layout BLAS runs fastest, kept in C order when fitted
         params = self._parameters.copy(layout="F")
@@ -496,6 +504,7 @@ class ConditionalRBM(BaseCRBM):
         self._parameters = best_parameters
         self.best_validation_score_ = best
 
+    @limit_blas_threads(frame_rows)
     def estimate_log_likelihood(
         self, X, *, sequence_ids=None, method="auto", reverse=True, random_state=None
     ):
