@@ -90,9 +90,7 @@ def map_jumps(pre, raw, sequence_ids):
     Z = pre.named_steps["expmap"].transform(raw)
     names = pre.named_steps["expmap"].get_feature_names_out()
     root = pre.named_steps["root"].root_
-    starts = [
-        i for i, n in enumerate(names) if n.endswith("_ex") and n != f"{root}_ex"
-    ]
+    starts = [i for i, n in enumerate(names) if n.endswith("_ex") and n != f"{root}_ex"]
     maps = np.stack([Z[:, i : i + 3] for i in starts], axis=1)
     step = np.linalg.norm(np.diff(maps, axis=0), axis=-1)
     return int(np.sum(step[np.diff(sequence_ids) == 0] > 1.0))
@@ -254,7 +252,9 @@ def main(argv=None):
             )
         )
     write_json(
-        "generation_bandai" if args.encoding == "default" else "generation_bandai_paper",
+        "generation_bandai"
+        if args.encoding == "default"
+        else "generation_bandai_paper",
         dict(
             encoding=args.encoding,
             n_iter=args.n_iter,
