@@ -1,5 +1,6 @@
 """The paper's preprocessing chain as one Pipeline."""
 
+import sklearn
 from sklearn.pipeline import Pipeline
 
 from ._data import StandardScaler
@@ -7,6 +8,31 @@ from ._expmap import ExpMapEncoder
 from ._root import RootRelativeEncoder
 
 __all__ = ["make_motion_preprocessor"]
+
+
+def _check_routing(params):
+    """Say how to turn routing on when ``sequence_ids`` is passed without it."""
+    if "sequence_ids" in params and not sklearn.get_config()["enable_metadata_routing"]:
+        raise ValueError(
+            "sequence_ids reaches the steps of a pipeline only through "
+            "scikit-learn's metadata routing, which is off. Turn it on once, "
+            "at the top of the script: sklearn.set_config("
+            "enable_metadata_routing=True) (or for a block: with "
+            "sklearn.config_context(enable_metadata_routing=True): ...). The "
+            "package's steps then receive sequence_ids wherever they need them."
+        )
+
+
+class MotionPipeline(Pipeline):
+    """A Pipeline whose ``fit`` explains metadata routing when it is off."""
+
+    def fit(self, X, y=None, **params):
+        _check_routing(params)
+        return super().fit(X, y, **params)
+
+    def fit_transform(self, X, y=None, **params):
+        _check_routing(params)
+        return super().fit_transform(X, y, **params)
 
 
 def make_motion_preprocessor(
@@ -81,7 +107,8 @@ def make_motion_preprocessor(
     -------
     pipeline : sklearn.pipeline.Pipeline
         Unfitted; ``get_feature_names_out()`` names every output channel
-        once fitted.
+        once fitted.  Its ``fit`` and ``fit_transform`` say how to turn
+        metadata routing on if ``sequence_ids`` is passed without it.
 
     Examples
     --------
@@ -108,7 +135,7 @@ def make_motion_preprocessor(
     """
     if angle_unit is None:
         angle_unit = getattr(skeleton, "angle_unit", None) or "deg"
-    return Pipeline(
+    return MotionPipeline(
         [
             (
                 "expmap",
