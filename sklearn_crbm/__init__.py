@@ -9,7 +9,7 @@ preprocessing, on-line filling in of missing channels, and generation.
 from . import datasets, metrics, model_selection, plotting, preprocessing
 from ._crbm import ConditionalRBM, TrainingDivergedError
 from ._stacked import StackedCRBM
-from .impute import CRBMImputer, NearestNeighborImputer
+from .impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from .preprocessing import (
     ExpMapEncoder,
     RootRelativeEncoder,
@@ -20,6 +20,7 @@ from .preprocessing import (
 __version__ = "0.1.0.dev0"
 
 __all__ = [
+    "AutoregressiveImputer",
     "CRBMImputer",
     "ConditionalRBM",
     "ExpMapEncoder",

@@ -7,6 +7,7 @@ from sklearn.utils.estimator_checks import (
 )
 
 from sklearn_crbm import ConditionalRBM
+from sklearn_crbm.impute import AutoregressiveImputer
 
 ROW_DEPENDENCE = (
     "rows are frames of sequences: each frame's output depends on the frames "
@@ -16,7 +17,10 @@ ROW_DEPENDENCE = (
 
 
 def _estimators():
-    return [ConditionalRBM(n_components=8, n_iter=5, random_state=0)]
+    return [
+        ConditionalRBM(n_components=8, n_iter=5, random_state=0),
+        AutoregressiveImputer(order=1),
+    ]
 
 
 def _expected_failed_checks(estimator):
