@@ -6,15 +6,8 @@ from pathlib import Path
 import numpy as np
 
 from ._parsing import format_number, parse_error, parse_floats, read_lines
-from ._skeleton import (
-    EULER_CHANNELS,
-    TRANSLATION_CHANNELS,
-    Bone,
-    Skeleton,
-    _as_frames,
-    _norm,
-    column_indices,
-)
+from ._channels import EULER_CHANNELS, TRANSLATION_CHANNELS, as_frames, column_indices
+from ._skeleton import Bone, Skeleton
 
 __all__ = ["read_amc", "read_asf", "write_amc"]
 
@@ -210,13 +203,10 @@ class _AsfParser:
         euler_axes = "".join(c[1] for c in channels if c in EULER_CHANNELS)
         order = root["axis"] or "xyz"
         rotation_order = "".join(a for a in order if a in euler_axes)
-        position = np.asarray(root["position"], dtype=np.float64)
-        length = _norm(position)
-        return Bone(
-            name="root",
-            parent=None,
-            direction=position / length if length else np.zeros(3),
-            length=length,
+        return Bone.from_offset(
+            "root",
+            None,
+            root["position"],
             channels=channels,
             rotation_order=rotation_order,
             axis=self._to_degrees(root["orientation"]),
@@ -484,7 +474,7 @@ def write_amc(path, data, skeleton, feature_names=None):
 
 def _ordered_channels(data, skeleton, feature_names):
     """``data`` as floats with its columns in ``skeleton.feature_names`` order."""
-    X = _as_frames(data)
+    X = as_frames(data)
     if X.ndim != 2:
         raise ValueError(
             f"data must be 2-D (n_frames, n_features), got shape {X.shape}."

@@ -7,7 +7,8 @@ import numpy as np
 
 from ..utils._rotations import matrix_to_euler
 from ._parsing import format_number, parse_error, parse_floats, read_lines
-from ._skeleton import EULER_CHANNELS, TRANSLATION_CHANNELS, Bone, Skeleton
+from ._channels import EULER_CHANNELS, TRANSLATION_CHANNELS
+from ._skeleton import Bone, Skeleton
 
 __all__ = ["read_bvh", "read_bvh_skeleton", "write_bvh"]
 
@@ -143,14 +144,11 @@ def _parse_channels(tokens):
 
 
 def _bvh_bone(name, parent, offset, channels):
-    with np.errstate(over="ignore"):
-        length = float(np.hypot(np.hypot(offset[0], offset[1]), offset[2]))
     rotation_axes = [c[1] for c in channels if c in EULER_CHANNELS]
-    return Bone(
-        name=name,
-        parent=parent,
-        direction=offset / length if length else np.zeros(3),
-        length=length,
+    return Bone.from_offset(
+        name,
+        parent,
+        offset,
         channels=channels,
         rotation_order="".join(reversed(rotation_axes)),
     )
@@ -217,8 +215,8 @@ def read_bvh(path):
     >>> path = os.path.join(tempfile.mkdtemp(), "walk.bvh")
     >>> write_bvh(path, walker.data, walker.skeleton, walker.frame_rate)
     >>> skeleton, data, names, frame_rate = read_bvh(path)
-    >>> data.shape, round(frame_rate, 6)
-    ((3, 33), 30.0)
+    >>> data.shape, round(frame_rate, 6)  # three rotation channels per joint
+    ((3, 57), 30.0)
     """
     header, motion = _split_header(path)
     skeleton = _skeleton_from_header(path, header)
@@ -286,14 +284,21 @@ def _parse_rows(path, rows, n_channels, n_frames, last_line):
 def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
     """Write motion as a BVH file for animation tools.
 
-    A bone of a BVH skeleton, or of an ASF skeleton without ``axis``
-    pre-rotation, keeps its Euler channels and values (angles in degrees).
-    Other rotations cannot be written as the same channels in a BVH file:
-    bones with an ASF ``axis`` pre-rotation (most limbs of the CMU
-    skeletons) and exponential maps (MIT data) are written as three channels
-    ``Zrotation Yrotation Xrotation`` holding the bone's rotation relative to
-    its parent, ``C @ M @ C^-1``.  Forward kinematics of what
-    :func:`read_bvh` reads back agrees with the skeleton's.
+    The file opens in Blender, pybvh, bvhio and bvhtoolbox, and their joint
+    positions are those of ``skeleton.forward_kinematics(data)``.  Every
+    joint has three rotation channels (Blender's importer reads no other
+    number): a bone of a BVH skeleton, or of an ASF skeleton without
+    ``axis`` pre-rotation, keeps its Euler channels and values (angles in
+    degrees), and the axes it lacks are added as zero channels after them.
+    Other rotations cannot be written as the same channels: bones with an
+    ASF ``axis`` pre-rotation (most limbs of the CMU skeletons), exponential
+    maps (MIT data) and joints without rotation channels are written as
+    ``Zrotation Yrotation Xrotation`` holding the bone's rotation relative
+    to its parent, ``C @ M @ C^-1`` (zero for a joint without rotation).
+    A joint with any position channel gets ``Xposition Yposition
+    Zposition``, holding its offset as every BVH reader uses it, so an ASF
+    root ``position`` is added to the root's translation channels (see
+    :meth:`Skeleton.local_offsets`).
 
     For an ASF skeleton every bone becomes a joint at the *start* of the
     bone, and leaf bones get an end site at their end; so the ASF position of
@@ -319,7 +324,9 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
     Raises
     ------
     ValueError
-        If a channel of the skeleton is missing or a value is not finite.
+        If a channel of the skeleton is missing, a value is not finite, or
+        the skeleton cannot be written as BVH (several roots, translation
+        channels on an ASF bone other than the root).
 
     Examples
     --------
@@ -344,9 +351,7 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
             "frame_rate must be positive, a number of frames per second such as "
             f"30.0, got {frame_rate!r}."
         )
-    roots = [bone.name for bone in skeleton.bones if bone.parent is None]
-    if len(roots) > 1:
-        raise ValueError(f"A BVH file has one ROOT; the skeleton has roots {roots}.")
+    _check_writable(skeleton)
     X, columns = skeleton._columns(data, feature_names)
     if not np.all(
         np.isfinite(X[:, [columns[n] for n in skeleton._required_channels()]])
@@ -354,9 +359,13 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
         raise ValueError(
             "data contain NaN or infinite values; fill them before writing."
         )
-    local = skeleton.local_rotations(
-        X, skeleton.feature_names if feature_names is None else feature_names
-    )
+    names = skeleton.feature_names if feature_names is None else feature_names
+    motion = {
+        "X": X,
+        "columns": columns,
+        "rotations": skeleton.local_rotations(X, names),
+        "offsets": skeleton.local_offsets(X, names),
+    }
     try:
         joints = _bvh_joints(skeleton)
         lines = ["HIERARCHY"]
@@ -367,7 +376,7 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
             "written as a BVH file."
         ) from None
     values = np.column_stack(
-        [_joint_values(skeleton, joint, X, columns, local) for joint in joints.values()]
+        [_joint_values(skeleton, joint, motion) for joint in joints.values()]
         or [np.empty((X.shape[0], 0))]
     )
     lines += [
@@ -380,18 +389,39 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
         f.write("\n".join(lines) + "\n")
 
 
-def _keeps_channels(skeleton, bone):
-    """Whether the bone's rotation is written as its own Euler channels."""
-    if bone.rotation_type == "expmap":
-        return False
-    return bone.rotation_type == "" or not np.any(bone.axis)
+def _check_writable(skeleton):
+    roots = [bone.name for bone in skeleton.bones if bone.parent is None]
+    if len(roots) > 1:
+        raise ValueError(f"A BVH file has one ROOT; the skeleton has roots {roots}.")
+    if skeleton.convention == "acclaim":
+        moving = [
+            bone.name
+            for bone in skeleton.bones[1:]
+            if any(c in TRANSLATION_CHANNELS for c in bone.channels)
+        ]
+        if moving:
+            raise ValueError(
+                f"The ASF bones {moving} have translation channels; only an ASF "
+                "root's translation can be written as BVH position channels."
+            )
+
+
+def _rotation_channels(bone):
+    """``(channels, baked)``: the joint's three BVH rotation channels (our short
+    names, in file order), and whether they hold a rotation turned into Euler
+    angles rather than the bone's own values."""
+    if bone.rotation_type != "euler" or np.any(bone.axis):
+        return ("rz", "ry", "rx"), True
+    own = tuple(f"r{a}" for a in reversed(bone.rotation_order))
+    missing = tuple(c for c in EULER_CHANNELS if c not in own)
+    return own + missing, False
 
 
 def _bvh_joints(skeleton):
     """Joints to write, in depth-first order, keyed by bone name.
 
     Each is a dict with the joint ``offset``, its BVH ``channels`` (our short
-    names), whether its rotation is ``baked`` into XYZ Euler angles, and the
+    names), whether its rotation is ``baked`` into Euler angles, and the
     ``end`` offset of an end site (``None`` when the joint has children).
     """
     index = {bone.name: i for i, bone in enumerate(skeleton.bones)}
@@ -399,22 +429,6 @@ def _bvh_joints(skeleton):
     joints = {}
     for bone in skeleton.bones:
         children = skeleton.children(bone.name)
-        if bone.parent is None:
-            offset = bone.offset
-        elif acclaim:
-            parent = skeleton.bones[index[bone.parent]]
-            offset = np.zeros(3) if parent.parent is None else parent.offset
-        else:
-            offset = bone.offset
-        translation = tuple(c for c in bone.channels if c in TRANSLATION_CHANNELS)
-        if _keeps_channels(skeleton, bone):
-            rotation = tuple(f"r{a}" for a in reversed(bone.rotation_order))
-            baked = False
-        else:
-            rotation, baked = ("rz", "ry", "rx"), True
-        end = None
-        if not children:
-            end = bone.offset if acclaim else np.zeros(3)
         if (
             not acclaim
             and not children
@@ -422,9 +436,19 @@ def _bvh_joints(skeleton):
             and bone.parent is not None
         ):
             continue  # a channel-less leaf of a BVH skeleton is its parent's end site
+        if acclaim and bone.parent is not None:
+            parent = skeleton.bones[index[bone.parent]]
+            offset = np.zeros(3) if parent.parent is None else parent.offset
+        else:
+            offset = bone.offset
+        moves = any(c in TRANSLATION_CHANNELS for c in bone.channels)
+        rotation, baked = _rotation_channels(bone)
+        end = None
+        if not children:
+            end = bone.offset if acclaim else np.zeros(3)
         joints[bone.name] = {
             "offset": offset,
-            "channels": translation + rotation,
+            "channels": (TRANSLATION_CHANNELS if moves else ()) + rotation,
             "baked": baked,
             "end": end,
         }
@@ -447,22 +471,25 @@ def _depth_first(skeleton, joints):
     return {name: dict(joints[name], name=name) for name in order}
 
 
-def _joint_values(skeleton, joint, X, columns, local):
+def _joint_values(skeleton, joint, motion):
+    """The joint's columns of the MOTION section, in its channel order."""
     bone = skeleton.bone(joint["name"])
-    n_frames = X.shape[0]
+    i = skeleton.bone_names.index(bone.name)
+    X, columns = motion["X"], motion["columns"]
+    values = dict(zip(TRANSLATION_CHANNELS, motion["offsets"][:, i].T, strict=True))
     if joint["baked"]:
-        i = skeleton.bone_names.index(bone.name)
-        euler = np.rad2deg(matrix_to_euler(local[:, i], "xyz"))  # columns rx, ry, rz
-        baked = {"rx": euler[:, 0], "ry": euler[:, 1], "rz": euler[:, 2]}
-    out = np.empty((n_frames, len(joint["channels"])))
-    for k, channel in enumerate(joint["channels"]):
-        if joint["baked"] and channel in baked:
-            out[:, k] = baked[channel]
-            continue
-        out[:, k] = X[:, columns[f"{bone.name}_{channel}"]]
-        if channel in EULER_CHANNELS and skeleton.angle_unit == "rad":
-            out[:, k] = np.rad2deg(out[:, k])
-    return out
+        euler = np.rad2deg(matrix_to_euler(motion["rotations"][:, i], "xyz"))
+        values.update(zip(EULER_CHANNELS, euler.T, strict=True))
+    else:
+        for channel in EULER_CHANNELS:
+            if channel in bone.channels:
+                angle = X[:, columns[f"{bone.name}_{channel}"]]
+            else:
+                angle = np.zeros(len(X))
+            if skeleton.angle_unit == "rad":
+                angle = np.rad2deg(angle)
+            values[channel] = angle
+    return np.column_stack([values[c] for c in joint["channels"]])
 
 
 def _hierarchy_lines(skeleton, joints, name, depth, lines):

@@ -1,8 +1,30 @@
-"""Finding the columns that belong to bones, by feature name."""
+"""Channels: their names, and the columns of raw data that hold them.
+
+The vocabulary that the skeleton, the file readers and the writers share,
+kept apart from the data model so that no module needs to know another
+module's file format.
+"""
 
 import numpy as np
 
-__all__ = ["bone_columns"]
+__all__ = [
+    "EULER_CHANNELS",
+    "EXPMAP_CHANNELS",
+    "KNOWN_CHANNELS",
+    "OFFSET_CHANNELS",
+    "TRANSLATION_CHANNELS",
+    "as_frames",
+    "bone_columns",
+    "column_indices",
+]
+
+EULER_CHANNELS = ("rx", "ry", "rz")
+EXPMAP_CHANNELS = ("ex", "ey", "ez")
+TRANSLATION_CHANNELS = ("tx", "ty", "tz")
+OFFSET_CHANNELS = ("ox", "oy", "oz")
+KNOWN_CHANNELS = (
+    EULER_CHANNELS + EXPMAP_CHANNELS + TRANSLATION_CHANNELS + OFFSET_CHANNELS
+)
 
 
 def bone_columns(feature_names, bones, *, strict=True):
@@ -60,3 +82,60 @@ def bone_columns(feature_names, bones, *, strict=True):
     if not columns:
         raise ValueError(f"None of the bones {bones} has a column in feature_names.")
     return np.array(sorted(set(columns)), dtype=np.intp)
+
+
+def as_frames(data):
+    """``data`` as a float64 array, or a clear error for sparse or non-numeric data.
+
+    The shape is checked by the caller.
+    """
+    if hasattr(data, "toarray") or hasattr(data, "tocsr"):
+        raise TypeError(
+            "data must be a dense array of raw channels, got a sparse matrix; "
+            "convert it with .toarray()."
+        )
+    try:
+        return np.asarray(data, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(
+            f"data must be a numeric array of shape (n_frames, n_features): {exc}"
+        ) from None
+
+
+def column_indices(feature_names, required, *, n_columns=None):
+    """Map each required feature name to its column.
+
+    Parameters
+    ----------
+    feature_names : array-like of str
+        Name of every column.
+    required : list of str
+        Names that must be present.
+    n_columns : int, default=None
+        Expected number of columns, checked when given.
+
+    Returns
+    -------
+    columns : dict
+        ``name -> column index`` for every name in ``feature_names``.
+
+    Raises
+    ------
+    ValueError
+        If a required name is missing (all missing names are listed), a name
+        repeats, or the number of names does not match ``n_columns``.
+    """
+    names = [str(n) for n in np.asarray(feature_names, dtype=object).ravel()]
+    if n_columns is not None and len(names) != n_columns:
+        raise ValueError(
+            f"Got {len(names)} feature names for data with {n_columns} columns."
+        )
+    columns = {}
+    for i, name in enumerate(names):
+        if name in columns:
+            raise ValueError(f"Feature name {name!r} occurs more than once.")
+        columns[name] = i
+    missing = [name for name in required if name not in columns]
+    if missing:
+        raise ValueError(f"The data lack these channels of the skeleton: {missing}.")
+    return columns

@@ -34,13 +34,8 @@ import os
 import numpy as np
 
 from ._parsing import load_mat_variables
-from ._skeleton import (
-    EXPMAP_CHANNELS,
-    OFFSET_CHANNELS,
-    TRANSLATION_CHANNELS,
-    Bone,
-    Skeleton,
-)
+from ._channels import EXPMAP_CHANNELS, OFFSET_CHANNELS, TRANSLATION_CHANNELS
+from ._skeleton import Bone, Skeleton
 
 __all__ = ["MIT_BONE_NAMES", "read_mit_skeleton"]
 
@@ -117,13 +112,11 @@ def read_mit_skeleton(skel, offsets=None):
         offset = np.zeros(3)
         if offsets is not None and not is_root:
             offset = offsets[offset_cols]
-        length = float(np.linalg.norm(offset))
         bones.append(
-            Bone(
-                name=MIT_BONE_NAMES[k],
-                parent=None if is_root else MIT_BONE_NAMES[parents[0]],
-                direction=offset / length if length else np.zeros(3),
-                length=length,
+            Bone.from_offset(
+                MIT_BONE_NAMES[k],
+                None if is_root else MIT_BONE_NAMES[parents[0]],
+                offset,
                 channels=EXPMAP_CHANNELS
                 + (TRANSLATION_CHANNELS if is_root else OFFSET_CHANNELS),
             )

@@ -17,9 +17,13 @@ Two conventions place the bones:
 ``"bvh"`` (BVH and Taylor's MIT data)
     Every bone is a joint placed at an offset from its parent, expressed in the
     parent's frame: ``position = position_parent + R_parent @ offset``, and
-    ``R = R_parent @ M``.
+    ``R = R_parent @ M``.  A joint's position channels (``Xposition`` ...)
+    *replace* the matching components of its offset, as pybvh, bvhio,
+    bvhtoolbox and Blender read BVH files; so a root at ``OFFSET 0 90 0``
+    with position channels sits where its channels say.
 
-In both, the root is placed at its offset plus its translation channels.
+In ``"acclaim"`` skeletons translation channels are *added* to the offset:
+the root is placed at its ASF ``position`` plus its translation channels.
 """
 
 from dataclasses import dataclass, field
@@ -27,16 +31,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..utils._rotations import euler_to_matrix, expmap_to_matrix
+from ._channels import (
+    EULER_CHANNELS,
+    EXPMAP_CHANNELS,
+    KNOWN_CHANNELS,
+    OFFSET_CHANNELS,
+    TRANSLATION_CHANNELS,
+    as_frames,
+    column_indices,
+)
 
 __all__ = ["Bone", "Skeleton"]
-
-EULER_CHANNELS = ("rx", "ry", "rz")
-EXPMAP_CHANNELS = ("ex", "ey", "ez")
-TRANSLATION_CHANNELS = ("tx", "ty", "tz")
-OFFSET_CHANNELS = ("ox", "oy", "oz")
-KNOWN_CHANNELS = (
-    EULER_CHANNELS + EXPMAP_CHANNELS + TRANSLATION_CHANNELS + OFFSET_CHANNELS
-)
 
 ANGLE_UNITS = ("deg", "rad")
 CONVENTIONS = ("acclaim", "bvh")
@@ -112,6 +117,30 @@ class Bone:
             )
         _check_bone_channels(self)
 
+    @classmethod
+    def from_offset(cls, name, parent, offset, **kwargs):
+        """A bone given by its offset vector rather than direction and length.
+
+        Parameters
+        ----------
+        name, parent : str
+            As for :class:`Bone` (``parent=None`` for a root).
+        offset : array-like of shape (3,)
+            ``length * direction``; a zero offset gives a bone of length 0.
+        **kwargs
+            The other fields of :class:`Bone` (``channels``, ...).
+
+        Examples
+        --------
+        >>> from sklearn_crbm.datasets import Bone
+        >>> bone = Bone.from_offset("Spine", "Hips", [0, 10, 0], channels=("rx",),
+        ...                         rotation_order="x")
+        >>> bone.length, bone.direction.tolist()
+        (10.0, [0.0, 1.0, 0.0])
+        """
+        offset = _vector3(offset, name, "offset")
+        return cls(name, parent, direction=offset, length=_norm(offset), **kwargs)
+
     @property
     def offset(self):
         """``length * direction``, shape (3,)."""
@@ -161,7 +190,8 @@ def _norm(vector):
     scale = np.max(np.abs(vector))
     if scale == 0:
         return 0.0
-    return float(scale * np.linalg.norm(vector / scale))
+    with np.errstate(over="ignore"):
+        return float(scale * np.linalg.norm(vector / scale))
 
 
 def _check_bone_channels(bone):
@@ -393,6 +423,21 @@ class Skeleton:
             [self._local_rotation(bone, X, columns) for bone in self.bones], axis=1
         )
 
+    def local_offsets(self, data, feature_names=None):
+        """Offset of every bone from its parent, per frame, (n_frames, n_bones, 3).
+
+        The bone's ``offset`` with its translation channels applied: in
+        ``"bvh"`` skeletons they replace the matching components, in
+        ``"acclaim"`` skeletons they are added (see the module docstring).
+        What a BVH file written with :func:`~sklearn_crbm.datasets.write_bvh`
+        holds in a joint's position channels.  Same parameters as
+        :meth:`forward_kinematics`.
+        """
+        X, columns = self._columns(data, feature_names)
+        return np.stack(
+            [self._local_offset(bone, X, columns) for bone in self.bones], axis=1
+        )
+
     def _global_transforms(self, data, feature_names):
         X, columns = self._columns(data, feature_names)
         n_frames, n_bones = X.shape[0], len(self.bones)
@@ -402,7 +447,7 @@ class Skeleton:
             zip(self.bones, self.parent_indices, strict=True)
         ):
             local = self._local_rotation(bone, X, columns)
-            offset = bone.offset + self._translation(bone, X, columns)
+            offset = self._local_offset(bone, X, columns)
             if parent < 0:
                 rotations[:, i] = local
                 positions[:, i] = offset
@@ -428,7 +473,7 @@ class Skeleton:
         ]
 
     def _columns(self, data, feature_names):
-        X = _as_frames(data)
+        X = as_frames(data)
         if X.ndim != 2:
             raise ValueError(
                 f"data must be 2-D (n_frames, n_features), got shape {X.shape}."
@@ -460,12 +505,23 @@ class Skeleton:
             M = C @ M @ C.T
         return M
 
-    def _translation(self, bone, X, columns):
-        t = np.zeros((X.shape[0], 3))
+    def _local_offset(self, bone, X, columns):
+        """Where the bone starts (BVH: the joint) relative to its parent, per frame.
+
+        BVH position channels *replace* the matching components of the
+        offset, as every BVH tool reads them (pybvh, bvhio, bvhtoolbox,
+        Blender); ASF translation channels are *added* to the offset (for an
+        ASF root, to its ``position``), as in the Acclaim format.
+        """
+        offset = np.tile(bone.offset, (X.shape[0], 1))
         for k, c in enumerate(TRANSLATION_CHANNELS):
             if c in bone.channels:
-                t[:, k] = X[:, columns[f"{bone.name}_{c}"]]
-        return t
+                values = X[:, columns[f"{bone.name}_{c}"]]
+                if self.convention == "bvh":
+                    offset[:, k] = values
+                else:
+                    offset[:, k] += values
+        return offset
 
     # ------------------------------------------------------------ constructors
     @classmethod
@@ -520,60 +576,3 @@ class Skeleton:
         from ._mit import read_mit_skeleton
 
         return read_mit_skeleton(skel, offsets)
-
-
-def _as_frames(data):
-    """``data`` as a float64 array, or a clear error for sparse or non-numeric data.
-
-    The shape is checked by the caller.
-    """
-    if hasattr(data, "toarray") or hasattr(data, "tocsr"):
-        raise TypeError(
-            "data must be a dense array of raw channels, got a sparse matrix; "
-            "convert it with .toarray()."
-        )
-    try:
-        return np.asarray(data, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(
-            f"data must be a numeric array of shape (n_frames, n_features): {exc}"
-        ) from None
-
-
-def column_indices(feature_names, required, *, n_columns=None):
-    """Map each required feature name to its column.
-
-    Parameters
-    ----------
-    feature_names : array-like of str
-        Name of every column.
-    required : list of str
-        Names that must be present.
-    n_columns : int, default=None
-        Expected number of columns, checked when given.
-
-    Returns
-    -------
-    columns : dict
-        ``name -> column index`` for every name in ``feature_names``.
-
-    Raises
-    ------
-    ValueError
-        If a required name is missing (all missing names are listed), a name
-        repeats, or the number of names does not match ``n_columns``.
-    """
-    names = [str(n) for n in np.asarray(feature_names, dtype=object).ravel()]
-    if n_columns is not None and len(names) != n_columns:
-        raise ValueError(
-            f"Got {len(names)} feature names for data with {n_columns} columns."
-        )
-    columns = {}
-    for i, name in enumerate(names):
-        if name in columns:
-            raise ValueError(f"Feature name {name!r} occurs more than once.")
-        columns[name] = i
-    missing = [name for name in required if name not in columns]
-    if missing:
-        raise ValueError(f"The data lack these channels of the skeleton: {missing}.")
-    return columns

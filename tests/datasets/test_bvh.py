@@ -91,6 +91,28 @@ def test_read_small_bvh(small_bvh):
     )
 
 
+def test_position_channels_replace_the_offset(tmp_path):
+    # as pybvh, bvhio, bvhtoolbox and Blender read them: a root OFFSET and a
+    # joint's OFFSET component are overridden by the joint's position channels
+    text = SMALL_BVH.replace("OFFSET 0 0 0\n", "OFFSET 5 90 7\n", 1).replace(
+        "CHANNELS 3", "CHANNELS 4 Yposition"
+    )
+    text = text.replace("1 2 3 0 0 0 0 0 0 0", "1 2 3 0 0 0 6 0 0 0 0")
+    text = text.replace("1 2 4 90 0 0 0 0 0 90", "1 2 4 0 0 0 7 0 0 0 0")
+    (tmp_path / "moving.bvh").write_text(text)
+    skeleton, data, names, _ = read_bvh(tmp_path / "moving.bvh")
+    assert "Spine_ty" in names
+    positions = skeleton.forward_kinematics(data)
+    np.testing.assert_allclose(positions[:, 0], [[1, 2, 3], [1, 2, 4]])
+    np.testing.assert_allclose(positions[:, 1], [[1, 8, 3], [1, 9, 4]])
+    np.testing.assert_allclose(
+        skeleton.local_offsets(data)[:, :2], [[[1, 2, 3], [0, 6, 0]], [[1, 2, 4], [0, 7, 0]]]
+    )
+    write_bvh(tmp_path / "copy.bvh", data, skeleton, 25.0)
+    copy, data2, _, _ = read_bvh(tmp_path / "copy.bvh")
+    np.testing.assert_allclose(copy.forward_kinematics(data2), positions, atol=1e-12)
+
+
 def test_skeleton_from_bvh_equals_read_bvh(small_bvh):
     skeleton = Skeleton.from_bvh(small_bvh)
     assert skeleton.bone_names == read_bvh(small_bvh)[0].bone_names
@@ -102,8 +124,10 @@ def test_bvh_round_trip_is_exact(tmp_path, small_bvh):
     path = tmp_path / "copy.bvh"
     write_bvh(path, data, skeleton, frame_rate)
     skeleton2, data2, names2, frame_rate2 = read_bvh(path)
-    np.testing.assert_array_equal(names2, names)
-    np.testing.assert_array_equal(data2, data)
+    # the one-channel Leg gets the two axes it lacks, as zero channels
+    np.testing.assert_array_equal(names2, [*names, "Leg_ry", "Leg_rz"])
+    np.testing.assert_array_equal(data2[:, :-2], data)
+    np.testing.assert_array_equal(data2[:, -2:], 0.0)
     assert frame_rate2 == pytest.approx(frame_rate, rel=1e-12)
     assert skeleton2.bone_names == skeleton.bone_names
     np.testing.assert_allclose(
@@ -164,10 +188,14 @@ def test_walker_to_bvh_keeps_every_channel(tmp_path):
     walker = make_walker(n_sequences=1, n_frames=20, random_state=0)
     write_bvh(tmp_path / "walk.bvh", walker.data, walker.skeleton, walker.frame_rate)
     bvh, data, names, frame_rate = read_bvh(tmp_path / "walk.bvh")
-    assert sorted(names) == sorted(walker.feature_names)
+    # every joint has three rotation channels: the ones a bone lacks are zero
+    assert set(walker.feature_names) < set(names)
+    assert all(len(b.rotation_order) == 3 for b in bvh.bones if b.channels)
     column = {name: i for i, name in enumerate(names)}
     order = [column[name] for name in walker.feature_names]
     np.testing.assert_array_equal(data[:, order], walker.data)
+    added = sorted(set(column.values()) - set(order))
+    np.testing.assert_array_equal(data[:, added], 0.0)
     asf_positions = walker.skeleton.forward_kinematics(walker.data)
     bvh_positions = bvh.forward_kinematics(data)[
         :, _asf_points_in_bvh(walker.skeleton, bvh)
