@@ -2,6 +2,9 @@
 
 - :class:`Skeleton` and :class:`Bone`: bones, channels, forward kinematics.
 - :func:`read_amc`, :func:`write_amc`, :func:`read_bvh`, :func:`write_bvh`.
+- :func:`read_bvh_folder` and :func:`read_amc_folder` read a folder of files
+  into long format; :func:`resample_frames` brings sequences to a common
+  frame rate.
 - :func:`load_cmu35` and :func:`load_mit_walk` load the real data from
   :func:`get_data_home`; :func:`fetch_cmu35` and :func:`fetch_mit_walk`
   download it.
@@ -14,6 +17,8 @@ from ._base import get_data_home, load_cmu35, load_mit_walk
 from ._bvh import read_bvh, write_bvh
 from ._channels import bone_columns
 from ._fetch import fetch_cmu35, fetch_mit_walk
+from ._folders import read_amc_folder, read_bvh_folder
+from ._frame_rate import resample_frames
 from ._generators import make_oscillations, make_walker
 from ._skeleton import Bone, Skeleton
 
@@ -29,7 +34,10 @@ __all__ = [
     "make_oscillations",
     "make_walker",
     "read_amc",
+    "read_amc_folder",
     "read_bvh",
+    "read_bvh_folder",
+    "resample_frames",
     "write_amc",
     "write_bvh",
 ]

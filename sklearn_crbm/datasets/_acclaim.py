@@ -5,8 +5,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._parsing import format_number, parse_error, parse_floats, read_lines
 from ._channels import EULER_CHANNELS, TRANSLATION_CHANNELS, as_frames, column_indices
+from ._parsing import format_number, parse_error, parse_floats, read_lines
 from ._skeleton import Bone, Skeleton
 
 __all__ = ["read_amc", "read_asf", "write_amc"]

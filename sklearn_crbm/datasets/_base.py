@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 from sklearn.utils import Bunch
 
+from ._frame_rate import kept_frames
 from ._mit import load_mit_mat, read_mit_skeleton
 from ._parsing import load_mat_variables
 from ._skeleton import Skeleton
@@ -36,7 +37,7 @@ MIT_SEQUENCE_NAMES = [
     "Normal1_M_2621-3660",
     "Normal1_M_3791-16300",
 ]
-MIT_DOWNSAMPLE = 4  # 120 Hz -> 30 Hz
+MIT_RECORDING_RATE = 120.0
 
 
 def get_data_home(data_home=None):
@@ -236,7 +237,10 @@ def load_mit_walk(data_home=None):
     path = _data_file(data_home, MIT_FOLDER, "data.mat", "fetch_mit_walk")
     skel, motions = load_mit_mat(path)
     skeleton = read_mit_skeleton(skel, motions[0][0])
-    sequences = [motion[::MIT_DOWNSAMPLE] for motion in motions]
+    sequences = [
+        motion[kept_frames(len(motion), MIT_RECORDING_RATE, FRAME_RATE)]
+        for motion in motions
+    ]
     return Bunch(
         data=np.concatenate(sequences),
         sequence_ids=np.repeat(np.arange(len(sequences)), [len(s) for s in sequences]),

@@ -1,13 +1,13 @@
 """Biovision BVH files: a skeleton header (HIERARCHY) and motion (MOTION)."""
 
-import numbers
 from pathlib import Path
 
 import numpy as np
 
 from ..utils._rotations import matrix_to_euler
-from ._parsing import format_number, parse_error, parse_floats, read_lines
 from ._channels import EULER_CHANNELS, TRANSLATION_CHANNELS
+from ._frame_rate import check_rate
+from ._parsing import format_number, parse_error, parse_floats, read_lines
 from ._skeleton import Bone, Skeleton
 
 __all__ = ["read_bvh", "read_bvh_skeleton", "write_bvh"]
@@ -342,15 +342,7 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
             f"{skeleton!r}; read one with sklearn_crbm.datasets.Skeleton.from_asf "
             "or Skeleton.from_bvh."
         )
-    if (
-        isinstance(frame_rate, bool)
-        or not isinstance(frame_rate, numbers.Real)
-        or not (0 < frame_rate < np.inf)
-    ):
-        raise ValueError(
-            "frame_rate must be positive, a number of frames per second such as "
-            f"30.0, got {frame_rate!r}."
-        )
+    frame_rate = check_rate(frame_rate, "frame_rate")
     _check_writable(skeleton)
     X, columns = skeleton._columns(data, feature_names)
     if not np.all(

@@ -33,8 +33,8 @@ import os
 
 import numpy as np
 
-from ._parsing import load_mat_variables
 from ._channels import EXPMAP_CHANNELS, OFFSET_CHANNELS, TRANSLATION_CHANNELS
+from ._parsing import load_mat_variables
 from ._skeleton import Bone, Skeleton
 
 __all__ = ["MIT_BONE_NAMES", "read_mit_skeleton"]

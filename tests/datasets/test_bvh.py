@@ -106,7 +106,8 @@ def test_position_channels_replace_the_offset(tmp_path):
     np.testing.assert_allclose(positions[:, 0], [[1, 2, 3], [1, 2, 4]])
     np.testing.assert_allclose(positions[:, 1], [[1, 8, 3], [1, 9, 4]])
     np.testing.assert_allclose(
-        skeleton.local_offsets(data)[:, :2], [[[1, 2, 3], [0, 6, 0]], [[1, 2, 4], [0, 7, 0]]]
+        skeleton.local_offsets(data)[:, :2],
+        [[[1, 2, 3], [0, 6, 0]], [[1, 2, 4], [0, 7, 0]]],
     )
     write_bvh(tmp_path / "copy.bvh", data, skeleton, 25.0)
     copy, data2, _, _ = read_bvh(tmp_path / "copy.bvh")

@@ -137,7 +137,9 @@ def test_asf_amc_written_as_bvh_opens_in_an_independent_reader(
     # an ASF bone's position is its end: where its first child joint, or its
     # end site, is in the BVH file
     expected = {
-        name: joints[name if name == "root" else (skeleton.children(name) or [f"{name}_end"])[0]]
+        name: joints[
+            name if name == "root" else (skeleton.children(name) or [f"{name}_end"])[0]
+        ]
         for name in skeleton.bone_names
     }
     assert_same_positions(

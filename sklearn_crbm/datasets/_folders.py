@@ -1,0 +1,228 @@
+"""Reading a folder of motion files into long format, one sequence per file."""
+
+import os
+from pathlib import Path
+
+import numpy as np
+from sklearn.utils import Bunch
+
+from ._acclaim import read_amc
+from ._bvh import read_bvh
+from ._frame_rate import RATIO_TOLERANCE, check_rate, kept_frames
+from ._skeleton import Skeleton
+
+__all__ = ["read_amc_folder", "read_bvh_folder"]
+
+
+def read_bvh_folder(folder, *, pattern="*.bvh", frame_rate=None):
+    """Read every BVH file of a folder into one long-format data set.
+
+    Each file is one sequence, named by its path relative to ``folder``
+    without the suffix; files are read in sorted order.  All files must
+    have the same channels (the same joints and channel order), as trials
+    of one capture set do.
+
+    Parameters
+    ----------
+    folder : path-like
+        The folder.
+    pattern : str, optional
+        Which files, as for :meth:`pathlib.Path.glob`; default ``"*.bvh"``.
+        ``"**/*.bvh"`` also reads sub-folders.
+    frame_rate : float, default=None
+        Frame rate of the returned data.  Files recorded faster are brought
+        down to it by dropping frames (see :func:`resample_frames`).
+        ``None`` keeps the files' rate, which must then be the same for all.
+
+    Returns
+    -------
+    data : :class:`~sklearn.utils.Bunch`
+        data : ndarray of shape (n_frames, n_features)
+            Raw channels of all files, one after the other.
+        sequence_ids : ndarray of shape (n_frames,)
+            Index into ``sequence_names`` of every frame.
+        sequence_names : ndarray of str
+            One name per file, e.g. ``"walk_01"`` or ``"subject1/walk_01"``.
+        feature_names : ndarray of str
+            The channels, as :func:`read_bvh` names them.
+        skeleton : Skeleton
+            The first file's skeleton.
+        skeletons : list of Skeleton
+            Each file's own skeleton (bone lengths may differ between files).
+        frame_rate : float
+            Frames per second of ``data``.
+        filenames : ndarray of str
+            The path of every file.
+        DESCR : str
+            Where the data came from.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``folder`` is not a folder or has no file matching ``pattern``.
+    ValueError
+        If a file is malformed, the files' channels differ, or their frame
+        rates differ and ``frame_rate`` is None.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from sklearn_crbm.datasets import make_walker, read_bvh_folder, write_bvh
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> for seed in (0, 1):
+    ...     walker = make_walker(n_sequences=1, n_frames=8, random_state=seed)
+    ...     write_bvh(folder / f"walk_{seed}.bvh", walker.data, walker.skeleton,
+    ...               frame_rate=120.0)
+    >>> walks = read_bvh_folder(folder, frame_rate=30.0)
+    >>> walks.data.shape, walks.sequence_ids.tolist(), list(walks.sequence_names)
+    ((4, 57), [0, 0, 1, 1], ['walk_0', 'walk_1'])
+    """
+    folder, paths = _matching_files(folder, pattern)
+    sequences = []
+    for path in paths:
+        skeleton, data, names, rate = read_bvh(path)
+        sequences.append((path, skeleton, data, rate))
+    return _long_format(folder, sequences, frame_rate, "BVH")
+
+
+def read_amc_folder(
+    folder, skeleton=None, *, pattern="*.amc", amc_frame_rate=120.0, frame_rate=None
+):
+    """Read every AMC file of a folder into one long-format data set.
+
+    Like :func:`read_bvh_folder` for Acclaim files.  Each AMC file is read
+    with ``skeleton`` when given; otherwise with the ASF file beside it
+    whose name is the longest start of the AMC file's name (``35.asf`` for
+    ``35_01.amc``, ``charleston.asf`` for ``charleston1.amc``), or the only
+    ASF file of its folder.
+
+    Parameters
+    ----------
+    folder : path-like
+        The folder.
+    skeleton : Skeleton or path-like, default=None
+        The skeleton of every file, or the path of its ASF file.
+    pattern : str, optional
+        Which files, as for :meth:`pathlib.Path.glob`; default ``"*.amc"``.
+    amc_frame_rate : float, default=120.0
+        Frames per second of the AMC files, which do not say (CMU: 120).
+    frame_rate : float, default=None
+        Frame rate of the returned data: files are brought down to it by
+        dropping frames (see :func:`resample_frames`).  ``None`` keeps
+        ``amc_frame_rate``.
+
+    Returns
+    -------
+    data : :class:`~sklearn.utils.Bunch`
+        As for :func:`read_bvh_folder`.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``folder`` is not a folder, has no file matching ``pattern``, or
+        an AMC file has no ASF file to go with it.
+    ValueError
+        If a file is malformed or the files' channels differ.
+
+    Examples
+    --------
+    >>> from sklearn_crbm.datasets import read_amc_folder
+    >>> cmu = read_amc_folder("cmu_subject35", frame_rate=30.0)  # doctest: +SKIP
+    >>> cmu.sequence_names[:2]  # doctest: +SKIP
+    array(['35_01', '35_02'], dtype=object)
+    """
+    amc_frame_rate = check_rate(amc_frame_rate, "amc_frame_rate")
+    folder, paths = _matching_files(folder, pattern)
+    if skeleton is not None and not isinstance(skeleton, Skeleton):
+        skeleton = Skeleton.from_asf(skeleton)
+    skeletons = {}
+    sequences = []
+    for path in paths:
+        own = skeleton
+        if own is None:
+            asf = _asf_for(path)
+            if asf not in skeletons:
+                skeletons[asf] = Skeleton.from_asf(asf)
+            own = skeletons[asf]
+        data, _ = read_amc(path, own)
+        sequences.append((path, own, data, amc_frame_rate))
+    return _long_format(folder, sequences, frame_rate, "AMC")
+
+
+def _matching_files(folder, pattern):
+    if not isinstance(folder, (str, os.PathLike)):
+        raise TypeError(
+            f"folder must be the path of a folder, got {type(folder).__name__} "
+            f"{folder!r}."
+        )
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise FileNotFoundError(f"{folder} is not a folder.")
+    paths = sorted(p for p in folder.glob(pattern) if p.is_file())
+    if not paths:
+        raise FileNotFoundError(f"No file in {folder} matches {pattern!r}.")
+    return folder, paths
+
+
+def _asf_for(amc_path):
+    """The ASF file that goes with an AMC file (see :func:`read_amc_folder`)."""
+    candidates = sorted(amc_path.parent.glob("*.asf"))
+    if len(candidates) == 1:
+        return candidates[0]
+    stem = amc_path.stem.lower()
+    prefixes = [asf for asf in candidates if stem.startswith(asf.stem.lower())]
+    if not prefixes:
+        raise FileNotFoundError(
+            f"No ASF file for {amc_path}: its folder has "
+            f"{[p.name for p in candidates]}, none of whose names starts "
+            f"{amc_path.stem!r}. Pass skeleton= to read_amc_folder."
+        )
+    return max(prefixes, key=lambda asf: len(asf.stem))
+
+
+def _long_format(folder, sequences, frame_rate, kind):
+    """The Bunch of :func:`read_bvh_folder` from ``(path, skeleton, data, rate)``."""
+    first_path, first_skeleton = sequences[0][:2]
+    for path, skeleton, _, _ in sequences[1:]:
+        if list(skeleton.feature_names) != list(first_skeleton.feature_names):
+            differ = sorted(
+                set(skeleton.feature_names) ^ set(first_skeleton.feature_names)
+            )
+            raise ValueError(
+                f"{path} and {first_path} have different channels "
+                f"({differ[:6] or 'the same ones in another order'}); read "
+                "files of different skeletons separately."
+            )
+    rates = [rate for _, _, _, rate in sequences]
+    if frame_rate is None:
+        frame_rate = rates[0]
+        if any(abs(rate - frame_rate) > RATIO_TOLERANCE * frame_rate for rate in rates):
+            raise ValueError(
+                f"The files have different frame rates {sorted(set(rates))}; pass "
+                "frame_rate= to bring them to a common rate by dropping frames."
+            )
+        kept = [data for _, _, data, _ in sequences]
+    else:
+        frame_rate = check_rate(frame_rate, "frame_rate")
+        kept = [
+            data[kept_frames(len(data), rate, frame_rate)]
+            for _, _, data, rate in sequences
+        ]
+    names = [
+        path.relative_to(folder).with_suffix("").as_posix()
+        for path, _, _, _ in sequences
+    ]
+    return Bunch(
+        data=np.concatenate(kept),
+        sequence_ids=np.repeat(np.arange(len(kept)), [len(d) for d in kept]),
+        sequence_names=np.array(names, dtype=object),
+        feature_names=first_skeleton.feature_names,
+        skeleton=first_skeleton,
+        skeletons=[skeleton for _, skeleton, _, _ in sequences],
+        frame_rate=frame_rate,
+        filenames=np.array([str(path) for path, _, _, _ in sequences], dtype=object),
+        DESCR=(
+            f"{len(kept)} {kind} files read from {folder}, "
+            f"{frame_rate:g} frames per second."
+        ),
+    )
