@@ -34,10 +34,6 @@ from ._base import check_imputer_input, complete_runs
 _FIRST_FRAME_ROUNDS = 3
 # Mean-field iterations of the one-step prediction that weights particles.
 _PREDICTION_STEPS = 10
-# history_noise of the default model: removes the drift of on-line fill-in on
-# CMU 35 (benchmarks/paper_fillin.py, 5 training seeds; 0.4 does too) and keeps
-# generated styles stable (benchmarks/generation_styles.py, where 0.4 does not).
-DEFAULT_HISTORY_NOISE = 0.8
 
 
 def _rng_from(random_state):
@@ -74,10 +70,10 @@ class CRBMImputer(
     ----------
     estimator : ConditionalRBM or StackedCRBM, default=None
         The model, cloned and trained by :meth:`fit`.  ``None`` means
-        ``ConditionalRBM(history_noise=0.8)``: trained on noisy histories so
-        that on-line fills do not drift (see Notes; with the paper's plain
-        schedule the filled upper body of a walk drifts for some training
-        seeds).  Standardise the data first (e.g. with
+        ``ConditionalRBM()``, whose default ``history_noise=0.8`` trains on
+        noisy histories so that on-line fills do not drift (see Notes; with
+        :meth:`ConditionalRBM.paper_schedule` the filled upper body of a
+        walk drifts for some training seeds).  Standardise the data first (e.g. with
         :class:`~sklearn_crbm.preprocessing.StandardScaler`): the visible
         units have unit variance.
     n_gibbs : int, default=30
@@ -262,7 +258,7 @@ class CRBMImputer(
             X = X[rows]
             estimator = self.estimator
             if estimator is None:
-                estimator = ConditionalRBM(history_noise=DEFAULT_HISTORY_NOISE)
+                estimator = ConditionalRBM()
             self.estimator_ = clone(estimator).fit(X, sequence_ids=run_ids)
             self.mean_ = X.mean(axis=0)
         return self
