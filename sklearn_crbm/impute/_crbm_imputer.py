@@ -25,7 +25,6 @@ from ..utils._sequences import Sequences, check_sequence_ids
 from ._base import check_imputer_input, complete_runs
 
 
-
 class CRBMImputer(
     VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
 ):
