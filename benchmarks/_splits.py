@@ -15,13 +15,12 @@ import joblib
 import numpy as np
 import sklearn
 
-from sklearn_crbm.datasets import bone_columns, load_cmu35
+from sklearn_crbm.datasets import load_cmu35
+from sklearn_crbm.model_selection import make_fillin_cases
 from sklearn_crbm.preprocessing import make_motion_preprocessor
 
 SPLITS = {"paper": ("35_29", "35_18"), "second": ("35_05", "35_22")}
 CELLS = ("walk/leg", "walk/upper", "jog/leg", "jog/upper")
-LEG_ROOT_BONE = "lfemur"  # the left leg: lfemur and everything below it
-UPPER_ROOT_BONE = "lowerback"  # the upper body: lowerback and every bone above it
 
 
 class Split:
@@ -36,15 +35,17 @@ class Split:
     X_test, test_ids : ndarray
         The two held-out trials (walk first), preprocessed.
     cases : dict
-        ``"walk/leg"`` ... ``"jog/upper"`` -> dict with ``X`` (the true
-        trial), ``mask`` (erased entries: the bones from half-way to the
-        end) and ``X_missing`` (``X`` with NaN there).
+        ``"walk/leg"`` ... ``"jog/upper"`` -> the case of
+        :func:`~sklearn_crbm.model_selection.make_fillin_cases` (``X``,
+        ``missing_mask``, ``X_missing``, ...): the left leg or the upper
+        body erased from half-way to the end.
     """
 
     def __init__(self, data_home, name):
         cmu = load_cmu35(data_home)
         names = list(cmu.sequence_names)
-        held_out = [names.index(trial) for trial in SPLITS[name]]
+        walk, jog = SPLITS[name]
+        held_out = [names.index(walk), names.index(jog)]
         train = ~np.isin(cmu.sequence_ids, held_out)
         with sklearn.config_context(enable_metadata_routing=True):
             self.preprocessor = make_motion_preprocessor(cmu.skeleton)
@@ -54,26 +55,19 @@ class Split:
         self.name = name
         self.trials = SPLITS[name]
         self.train_ids = cmu.sequence_ids[train]
-        feature_names = self.preprocessor.get_feature_names_out()
-        columns = {
-            part: bone_columns(
-                feature_names, cmu.skeleton.descendants(bone), strict=False
-            )
-            for part, bone in (("leg", LEG_ROOT_BONE), ("upper", UPPER_ROOT_BONE))
+        cases = make_fillin_cases(
+            cmu, self.preprocessor, trials={"walk": walk, "jog": jog}
+        )
+        parts = {"left leg": "leg", "upper body": "upper"}
+        self.cases = {
+            f"{motion}/{parts[part]}": case for (motion, part), case in cases.items()
         }
-        tests, self.cases = [], {}
-        for motion, sequence in zip(("walk", "jog"), held_out, strict=True):
-            X = self.preprocessor.transform(cmu.data[cmu.sequence_ids == sequence])
-            tests.append(X)
-            first = len(X) - len(X) // 2
-            for part, cols in columns.items():
-                mask = np.zeros(X.shape, dtype=bool)
-                mask[first:, cols] = True
-                self.cases[f"{motion}/{part}"] = dict(
-                    X=X, mask=mask, X_missing=np.where(mask, np.nan, X)
-                )
-        self.X_test = np.concatenate(tests)
-        self.test_ids = np.repeat(np.arange(2), [len(X) for X in tests])
+        self.X_test = np.concatenate(
+            [self.cases["walk/leg"].X, self.cases["jog/leg"].X]
+        )
+        self.test_ids = np.repeat(
+            np.arange(2), [len(self.cases["walk/leg"].X), len(self.cases["jog/leg"].X)]
+        )
 
 
 # What a trained model depends on: the cache key leaves out parameters that

@@ -92,8 +92,8 @@ def fitted_imputer(cache_dir, split, model, seed, n_iter):
 def errors(imputer, split):
     out = {}
     for cell, case in split.cases.items():
-        filled = imputer.transform(case["X_missing"])
-        out[cell] = float(fillin_error(case["X"], filled, missing_mask=case["mask"]))
+        filled = imputer.transform(case.X_missing)
+        out[cell] = float(fillin_error(case.X, filled, missing_mask=case.missing_mask))
     return out
 
 
@@ -164,14 +164,12 @@ def report(split_name, trials, base, best, crbm):
     print(header)
     print("|" + "-" * 36 + "|" + "------------|" * len(CELLS))
     if split_name == "paper":
+        cells = [
+            f"{PAPER[c][0]:.2f}/{PAPER[c][1]:.2f}" if c in PAPER else "-" for c in CELLS
+        ]
         print(
-            f"| {'paper: CRBM (nearest neighbour)':34s} |"
-            + "".join(
-                f" {PAPER[c][0]:>4.2f} ({PAPER[c][1]:.2f})"[-11:].rjust(11) + " |"
-                if c in PAPER
-                else f" {'-':>10s} |"
-                for c in CELLS
-            )
+            f"| {'paper: CRBM/nearest neighbour':34s} |"
+            + "".join(f" {cell:>10s} |" for cell in cells)
         )
     for name, row in base.items():
         print(f"| {name:34s} |" + "".join(f" {row[c]:>10.2f} |" for c in CELLS))
