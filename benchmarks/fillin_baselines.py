@@ -39,7 +39,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 from _splits import CELLS, SPLITS, Split, cached_model  # noqa: E402
-from sklearn.base import clone  # noqa: E402
+from sklearn.frozen import FrozenEstimator  # noqa: E402
 from sklearn.impute import KNNImputer  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
@@ -75,18 +75,16 @@ def crbm_model(name, seed, n_iter):
 def fitted_imputer(cache_dir, split, model, seed, n_iter):
     """``CRBMImputer(model).fit(X_train)``, with the model's training cached.
 
-    ``fit`` trains a clone of the model and keeps the training mean; the
-    cached fitted clone is put in its place (the same result, without
-    retraining for every run).
+    ``fit`` would train a clone of the model; the cached fitted clone goes in
+    through ``FrozenEstimator`` instead (the same imputer, without retraining
+    for every run).
     """
-    crbm = crbm_model(model, seed, n_iter)
     X = split.X_train.astype(np.float32)
-    fitted, seconds = cached_model(cache_dir, clone(crbm), X, split.train_ids)
-    imputer = CRBMImputer(crbm, random_state=seed)
-    imputer.estimator_ = fitted
-    imputer.mean_ = X.mean(axis=0)
-    imputer.n_features_in_ = X.shape[1]
-    return imputer, seconds
+    fitted, seconds = cached_model(
+        cache_dir, crbm_model(model, seed, n_iter), X, split.train_ids
+    )
+    imputer = CRBMImputer(FrozenEstimator(fitted), random_state=seed)
+    return imputer.fit(X, sequence_ids=split.train_ids), seconds
 
 
 def errors(imputer, split):
