@@ -37,7 +37,8 @@ later reuses it.  Run from the repository root, with one BLAS thread::
     OPENBLAS_NUM_THREADS=1 python benchmarks/model_selection.py
     OPENBLAS_NUM_THREADS=1 python benchmarks/model_selection.py --sizes 10 50 --orders 0 1
 
-Prints a table and writes ``benchmarks/results/model_selection.json``.
+Prints a table and writes ``benchmarks/results/model_selection_hn{noise}.json``
+(``--history-noise``, default the estimator's).
 """
 
 import argparse
@@ -169,13 +170,25 @@ def ar_log_likelihood(data, order):
     return float(np.mean(log_density.sum(axis=1)))
 
 
+def history_noise(args):
+    """The ``history_noise`` of the grid: the option, else the estimator's default."""
+    if args.history_noise is None:
+        return ConditionalRBM().history_noise
+    return args.history_noise
+
+
 def run_one(data, n_components, order, fold, args):
-    key = f"h{n_components}_o{order}_f{fold}_it{args.n_iter}_s{args.seed}"
+    noise = history_noise(args)
+    key = f"h{n_components}_o{order}_f{fold}_it{args.n_iter}_s{args.seed}_hn{noise:g}"
     path = CACHE / f"{key}.json"
     if path.exists() and not args.no_cache:
         return json.loads(path.read_text())
     model = ConditionalRBM(
-        n_components, order=order, n_iter=args.n_iter, random_state=args.seed
+        n_components,
+        order=order,
+        n_iter=args.n_iter,
+        history_noise=noise,
+        random_state=args.seed,
     )
     start = time.process_time()
     model.fit(data["Z_train"], sequence_ids=data["train_ids"])
@@ -245,6 +258,12 @@ def main(argv=None):
     parser.add_argument("--folds", type=int, nargs="+", default=[0, 1, 2])
     parser.add_argument("--n-iter", type=int, default=500)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--history-noise",
+        type=float,
+        default=None,
+        help="ConditionalRBM's history_noise (default: the estimator's default)",
+    )
     parser.add_argument("--no-cache", action="store_true", help="refit everything")
     parser.add_argument("--output", default=None)
     args = parser.parse_args(argv)
@@ -285,7 +304,10 @@ def main(argv=None):
             ("fillin", "fill-in mean", ".3f"),
             ("generation", "gen. speed/freq err", ".3f"),
         ],
-        title=f"CMU 35, folds {args.folds}, {args.n_iter} epochs, seed {args.seed}",
+        title=(
+            f"CMU 35, folds {args.folds}, {args.n_iter} epochs, seed {args.seed}, "
+            f"history_noise {history_noise(args):g}"
+        ),
     )
     ar_rows = [
         dict(
@@ -323,7 +345,7 @@ def main(argv=None):
         f"{summary['total_fit_time']:.1f} s in all"
     )
     write_json(
-        "model_selection",
+        f"model_selection_hn{history_noise(args):g}",
         dict(
             args=vars(args),
             results=results,

@@ -287,3 +287,25 @@ def test_early_stopping_needs_several_sequences():
     model = ConditionalRBM(4, order=1, early_stopping=True, n_iter=5)
     with pytest.raises(ValueError, match="single sequence"):
         model.fit(frames(50, 3))
+
+
+def test_learned_visible_variances_enter_the_likelihood():
+    X = frames(240, 2)
+    ids = np.repeat(np.arange(6), 40)
+    model = ConditionalRBM(
+        5,
+        order=1,
+        visible_variance="learned",
+        n_iter=30,
+        learning_rate=0.01,
+        random_state=0,
+    ).fit(X, sequence_ids=ids)
+    variance = model.visible_variance_
+    assert not np.allclose(variance, 1)
+    exact = model.estimate_log_likelihood(X[:40], method="exact").log_likelihood
+    for t in (1, 10, 39):
+        assert exact[t] == pytest.approx(
+            brute_force_log_likelihood(model, X[:40], t), abs=1e-6
+        )
+    ais = model.estimate_log_likelihood(X[:40], method="ais", reverse=False)
+    assert abs(ais.log_likelihood.mean() - exact.mean()) < 0.05
