@@ -654,7 +654,7 @@ class ConditionalRBM(BaseCRBM):
         >>> result.method
         'ais'
         >>> print(f"{result.log_likelihood.mean():.2f} {result.lower.mean():.2f}")
-        -5.57 -5.57
+        -5.60 -5.60
         """
         if method not in ("auto", "exact", "ais"):
             raise ValueError(
