@@ -34,11 +34,11 @@ from _common import (
 from sklearn_crbm import ConditionalRBM
 
 REAL_TIME_FPS = 30.0
-LEG = ("lfemur", "ltibia", "lfoot", "ltoes")
 
 
 def load(data_home):
-    from sklearn_crbm.datasets import load_cmu35
+    from sklearn_crbm.datasets import bone_columns, load_cmu35
+    from sklearn_crbm.model_selection import paper_body_parts
     from sklearn_crbm.preprocessing import make_motion_preprocessor
 
     train = load_cmu35(data_home, subset="train")
@@ -47,16 +47,10 @@ def load(data_home):
         pre = make_motion_preprocessor(train.skeleton)
         Z_train = pre.fit_transform(train.data, sequence_ids=train.sequence_ids)
         Z_test = pre.transform(test.data, sequence_ids=test.sequence_ids)
-    names = list(pre.get_feature_names_out())
-    skeleton = train.skeleton
-    upper, stack = [], ["lowerback"]
-    while stack:
-        bone = stack.pop()
-        upper.append(bone)
-        stack.extend(getattr(c, "name", c) for c in skeleton.children(bone))
+    names = pre.get_feature_names_out()
     parts = {
-        "left leg": [i for i, n in enumerate(names) if n.split("_")[0] in LEG],
-        "upper body": [i for i, n in enumerate(names) if n.split("_")[0] in upper],
+        part: bone_columns(names, bones, strict=False)
+        for part, bones in paper_body_parts(train.skeleton).items()
     }
     return Z_train, train.sequence_ids, Z_test, test.sequence_ids, parts
 

@@ -60,7 +60,9 @@ def load_motion(name, data_home):
         return motion, ("walk", "jog")
     mit = load_mit_walk(data_home)
     pre = make_motion_preprocessor(mit.skeleton)
-    motion = styles.Motion(mit.data, mit.sequence_ids, mit.motion, pre, mit.frame_rate)
+    motion = styles.Motion(
+        mit.data, mit.sequence_ids, mit.motion, pre, mit.frame_rate, styles.MIT_LEGS
+    )
     return motion, ("walk",)
 
 

@@ -70,23 +70,24 @@ import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
-from sklearn_crbm.datasets import load_cmu35  # noqa: E402
+from sklearn_crbm.datasets import bone_columns, load_cmu35  # noqa: E402
 from sklearn_crbm.metrics import (  # noqa: E402
     forward_speed,
+    gait_statistics,
     motion_amplitude,
     nearest_style,
     spectral_similarity,
-    step_frequency,
 )
 from sklearn_crbm.preprocessing import make_motion_preprocessor  # noqa: E402
-from sklearn_crbm.utils._sequences import check_sequence_ids  # noqa: E402
+from sklearn_crbm.utils import check_sequence_ids, random_windows  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "benchmarks" / "results"
 DEFAULT_DATA_HOME = os.environ.get(
     "SKLEARN_CRBM_DATA", str(REPO.parent / "shared" / "data")
 )
-LEG_BONES = ("lfemur", "rfemur", "ltibia", "rtibia")
+CMU_LEGS = ("lfemur", "rfemur", "ltibia", "rtibia")  # hips and knees
+MIT_LEGS = ("lhip", "rhip", "lknee", "rknee")
 BLOW_UP = 10.0
 VARIANTS = {
     "faithful": {},
@@ -98,7 +99,9 @@ VARIANTS = {
 class Motion:
     """Preprocessed motion and the statistics of its trials."""
 
-    def __init__(self, data, sequence_ids, styles, preprocessor, frame_rate):
+    def __init__(
+        self, data, sequence_ids, styles, preprocessor, frame_rate, legs=CMU_LEGS
+    ):
         self.preprocessor = preprocessor
         self.ids = sequence_ids
         self.styles = np.asarray(styles, dtype=object)
@@ -109,35 +112,37 @@ class Motion:
         self.root_names = np.asarray(
             preprocessor[:-1].get_feature_names_out(), dtype=object
         )
-        self.legs = [n for n in self.names if n.split("_")[0] in LEG_BONES]
-        if not self.legs:  # MIT names its leg joints lhip/lknee
-            self.legs = [
-                n
-                for n in self.names
-                if n.split("_")[0] in ("lhip", "rhip", "lknee", "rknee")
-            ]
+        self.leg_bones = legs
+        self.legs = list(self.names[bone_columns(self.names, legs)])
         self.train_stats = self.statistics(self.Z, self.ids)
 
     def statistics(self, Z, ids, last_frames=None):
-        """Per-sequence speed, gait frequency, leg amplitude and max |z|."""
+        """Per-sequence gait statistics, speed, leg amplitude and max |z|.
+
+        ``gait`` (z-scored speed and gait frequency) is what styles are
+        classified on; ``speed`` is the same speed in the encoder's units
+        (ASF units per frame), for the table and the stall criterion.
+        """
         Z = np.asarray(Z, dtype=np.float64)
         finite = np.clip(np.nan_to_num(Z, nan=0.0), -1e3, 1e3)
         unscaled = self.preprocessor[-1].inverse_transform(finite)
+        gait = gait_statistics(
+            finite,
+            sequence_ids=ids,
+            feature_names=self.names,
+            legs=self.leg_bones,
+            frame_rate=self.frame_rate,
+            last_frames=last_frames,
+        )
         stats = {
+            "gait": gait,
             "speed": forward_speed(
                 unscaled,
                 sequence_ids=ids,
                 feature_names=self.root_names,
                 last_frames=last_frames,
             ),
-            "frequency": step_frequency(
-                finite,
-                sequence_ids=ids,
-                feature_names=self.names,
-                features=self.legs,
-                frame_rate=self.frame_rate,
-                last_frames=last_frames,
-            ),
+            "frequency": gait[:, 1],
             "amplitude": motion_amplitude(
                 finite,
                 sequence_ids=ids,
@@ -182,16 +187,19 @@ def load_cmu_motion(data_home):
 
 def draw_seeds(motion, n_per_style, width, rng, styles=("walk", "jog")):
     """``width`` consecutive real frames from random trials of each style."""
-    seeds, seed_styles = [], []
-    for style in styles:
-        trials = np.flatnonzero(motion.styles == style)
-        for _ in range(n_per_style):
-            trial = rng.choice(trials)
-            rows = np.flatnonzero(motion.ids == trial)
-            start = rng.integers(0, len(rows) - width + 1)
-            seeds.append(motion.Z[rows[start : start + width]])
-            seed_styles.append(style)
-    return np.stack(seeds), np.asarray(seed_styles, dtype=object)
+    seeds = [
+        random_windows(
+            motion.Z,
+            sequence_ids=motion.ids,
+            width=width,
+            n_windows=n_per_style,
+            sequences=np.flatnonzero(motion.styles == style),
+            random_state=rng,
+        )
+        for style in styles
+    ]
+    seed_styles = np.repeat(np.asarray(styles, dtype=object), n_per_style)
+    return np.concatenate(seeds), seed_styles
 
 
 def judge(motion, generated, n_frames, seed_styles, last_frames=100):
@@ -203,9 +211,7 @@ def judge(motion, generated, n_frames, seed_styles, last_frames=100):
         np.nan_to_num(generated, nan=np.inf).reshape(n_sequences, n_frames, -1)
     ).max(axis=(1, 2))
     train = motion.train_stats
-    reference = np.column_stack([train["speed"], train["frequency"]])
-    features = np.column_stack([stats["speed"], stats["frequency"]])
-    stats["style"] = nearest_style(features, reference, motion.styles)
+    stats["style"] = nearest_style(stats["gait"], train["gait"], motion.styles)
     walk_speed = train["speed"][motion.styles == "walk"].mean()
     stats["dead"] = stats["amplitude"] < 0.5 * train["amplitude"].mean()
     stats["stalled"] = stats["speed"] < 0.5 * walk_speed

@@ -58,11 +58,7 @@ def window_labels(motion, generated, n_frames, window, hop):
     ids = np.repeat(np.arange(n_sequences * len(starts)), window)
     stats = motion.statistics(windows, ids)
     train = motion.train_stats
-    labels = nearest_style(
-        np.column_stack([stats["speed"], stats["frequency"]]),
-        np.column_stack([train["speed"], train["frequency"]]),
-        motion.styles,
-    )
+    labels = nearest_style(stats["gait"], train["gait"], motion.styles)
     walk_speed = train["speed"][motion.styles == "walk"].mean()
     # the amplitude of a short window is smaller than a trial's: compare
     # with the training trials' windows of the same length

@@ -80,13 +80,13 @@ from sklearn.impute import IterativeImputer, KNNImputer  # noqa: E402
 from sklearn_crbm import ConditionalRBM  # noqa: E402
 from sklearn_crbm.datasets import load_cmu35  # noqa: E402
 from sklearn_crbm.impute import CRBMImputer, NearestNeighborImputer  # noqa: E402
-from sklearn_crbm.metrics import fillin_angle_rmse, fillin_error  # noqa: E402
+from sklearn_crbm.metrics import fillin_error  # noqa: E402
+from sklearn_crbm.model_selection import make_fillin_cases  # noqa: E402
 from sklearn_crbm.preprocessing import make_motion_preprocessor  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 PAPER = {("walk", "leg"): (8.78, 11.68), ("walk", "upper"): (20.52, 22.20)}
-LEG_BONES = ("lfemur", "ltibia", "lfoot", "ltoes")
-UPPER_ROOT_BONE = "lowerback"
+PARTS = {"left leg": "leg", "upper body": "upper"}  # short names in the JSON
 
 # The original code's training schedule (REFERENCE.md), 200 hidden, order 3.
 ORIGINAL_MODEL = dict(
@@ -142,74 +142,17 @@ def parse_args():
 
 
 def load(data_home):
-    """Preprocessed training data and the two test sequences, with raw frames."""
+    """Preprocessed training data and the paper's four fill-in cases."""
     train = load_cmu35(data_home, subset="train")
     test = load_cmu35(data_home, subset="test")
     with sklearn.config_context(enable_metadata_routing=True):
         pre = make_motion_preprocessor(train.skeleton)
         Z_train = pre.fit_transform(train.data, sequence_ids=train.sequence_ids)
-    names = pre.get_feature_names_out()
-    raw_names = np.asarray(train.feature_names)
-    skeleton = train.skeleton
-    upper = _descendants(skeleton, UPPER_ROOT_BONE)
-    bone_sets = {"leg": list(LEG_BONES), "upper": upper}
-    cases = {}
-    for motion, trial in (("walk", "35_29"), ("jog", "35_18")):
-        seq = list(test.sequence_names).index(trial)
-        raw = test.data[test.sequence_ids == seq]
-        with sklearn.config_context(enable_metadata_routing=True):
-            Z = pre.transform(raw)
-        n = len(Z)
-        first = n - n // 2
-        for part, bones in bone_sets.items():
-            columns = _columns(names, bones)
-            raw_columns = _columns(raw_names, bones)
-            mask = np.zeros(Z.shape, dtype=bool)
-            mask[first:, columns] = True
-            raw_mask = np.zeros(raw.shape, dtype=bool)
-            raw_mask[first:, raw_columns] = True
-            X_missing = Z.copy()
-            X_missing[mask] = np.nan
-            cases[(motion, part)] = dict(
-                Z=Z,
-                raw=raw,
-                mask=mask,
-                raw_mask=raw_mask,
-                X_missing=X_missing,
-                first=first,
-                trial=trial,
-                n_channels=len(columns),
-            )
-    return pre, Z_train, train.sequence_ids, cases, bone_sets
-
-
-def _descendants(skeleton, name):
-    bones, stack = [], [name]
-    while stack:
-        bone = stack.pop(0)
-        bones.append(bone)
-        stack.extend(
-            child.name if hasattr(child, "name") else child
-            for child in skeleton.children(bone)
-        )
-    return bones
-
-
-def _columns(names, bones):
-    prefixes = tuple(f"{bone}_" for bone in bones)
-    columns = [i for i, name in enumerate(names) if str(name).startswith(prefixes)]
-    if not columns:
-        raise ValueError(f"no column for bones {bones}")
-    return columns
-
-
-def errors(pre, case, filled):
-    """(paper error, RMS degrees) of one fill of one case."""
-    normalised = fillin_error(case["Z"], filled, missing_mask=case["mask"])
-    with sklearn.config_context(enable_metadata_routing=True):
-        raw = pre.inverse_transform(filled)
-    degrees = fillin_angle_rmse(case["raw"], raw, missing_mask=case["raw_mask"])
-    return normalised, degrees
+    cases = {
+        (motion, PARTS[part]): case
+        for (motion, part), case in make_fillin_cases(test, pre).items()
+    }
+    return Z_train, train.sequence_ids, cases
 
 
 def linear_interpolation(X_missing):
@@ -223,7 +166,7 @@ def linear_interpolation(X_missing):
     return X
 
 
-def baselines(pre, Z_train, cases):
+def baselines(Z_train, cases):
     methods = {
         "nearest neighbour": NearestNeighborImputer(),
         "KNNImputer(5)": KNNImputer(n_neighbors=5),
@@ -233,11 +176,10 @@ def baselines(pre, Z_train, cases):
     for name, imputer in methods.items():
         imputer.fit(Z_train)
         for key, case in cases.items():
-            filled = imputer.transform(case["X_missing"])
-            results[(name, *key)] = errors(pre, case, filled)
+            results[(name, *key)] = case.errors(imputer.transform(case.X_missing))
     for key, case in cases.items():
-        results[("linear interpolation", *key)] = errors(
-            pre, case, linear_interpolation(case["X_missing"])
+        results[("linear interpolation", *key)] = case.errors(
+            linear_interpolation(case.X_missing)
         )
     return results
 
@@ -262,7 +204,7 @@ def _with_new_parameters(imputer):
     return imputer
 
 
-def crbm_results(pre, imputer, imputer_params, seed, cases, n_repeats, n_draws):
+def crbm_results(imputer, imputer_params, seed, cases, n_repeats, n_draws):
     """Single draws (mean error over them) and the average of ``n_draws`` draws.
 
     ``transform`` with ``n_draws=k`` returns the mean of ``sample(k)`` drawn
@@ -273,10 +215,10 @@ def crbm_results(pre, imputer, imputer_params, seed, cases, n_repeats, n_draws):
     out = {}
     for key, case in cases.items():
         draws = imputer.sample(
-            case["X_missing"], n_samples=max(n_repeats, n_draws), random_state=seed
+            case.X_missing, n_samples=max(n_repeats, n_draws), random_state=seed
         )
-        single = np.array([errors(pre, case, filled) for filled in draws[:n_repeats]])
-        averaged = errors(pre, case, draws[:n_draws].mean(axis=0))
+        single = np.array([case.errors(filled) for filled in draws[:n_repeats]])
+        averaged = case.errors(draws[:n_draws].mean(axis=0))
         out[key] = dict(
             single=single[:, 0].mean(),
             single_std=single[:, 0].std(),
@@ -300,7 +242,7 @@ def true_past_error(imputer, case, n_draws, seed):
     from fills feeding back through the directed connections (the drift).
     """
     n_lags = max(imputer.estimator_.order, imputer.estimator_.hidden_order or 0)
-    Z, mask = case["Z"], case["mask"]
+    Z, mask = case.X, case.missing_mask
     rows = np.flatnonzero(mask.any(axis=1))
     windows = rows[:, None] + np.arange(-n_lags, 1)
     X = Z[windows]
@@ -317,17 +259,18 @@ def true_past_error(imputer, case, n_draws, seed):
 def main():
     args = parse_args()
     dtype = np.dtype(args.dtype)
-    pre, Z_train, sequence_ids, cases, bone_sets = load(args.data_home)
+    Z_train, sequence_ids, cases = load(args.data_home)
     print(
-        f"training frames {Z_train.shape}, upper body: {', '.join(bone_sets['upper'])}"
+        f"training frames {Z_train.shape}, upper body: "
+        f"{', '.join(cases['walk', 'upper'].bones)}"
     )
     for key, case in cases.items():
         print(
-            f"  {case['trial']} {key[0]:4s} {key[1]:5s}: {len(case['Z'])} frames, "
-            f"erased frames {case['first']}..{len(case['Z']) - 1}, "
-            f"{case['n_channels']} channels"
+            f"  {case.trial} {key[0]:4s} {key[1]:5s}: {len(case.X)} frames, "
+            f"erased frames {case.first_missing}..{len(case.X) - 1}, "
+            f"{case.missing_mask.any(axis=0).sum()} channels"
         )
-    base = baselines(pre, Z_train, cases)
+    base = baselines(Z_train, cases)
     memory = joblib.Memory(args.cache_dir or None, verbose=0)
     train = memory.cache(_train_imputer)
     Z_fit = Z_train.astype(dtype)
@@ -360,7 +303,6 @@ def main():
         for seed in args.seeds:
             start = time.perf_counter()
             res = crbm_results(
-                pre,
                 trained[(key, seed)],
                 spec["imputer"],
                 seed,

@@ -17,7 +17,6 @@ from sklearn.pipeline import Pipeline
 
 from ._crbm import ConditionalRBM
 from .datasets import (
-    bone_columns,
     fetch_cmu35,
     fetch_mit_walk,
     get_data_home,
@@ -25,20 +24,13 @@ from .datasets import (
     write_amc,
 )
 from .impute import CRBMImputer, NearestNeighborImputer
-from .metrics import (
-    fillin_angle_rmse,
-    fillin_error,
-    forward_speed,
-    nearest_style,
-    step_frequency,
-)
+from .metrics import gait_statistics, nearest_style
+from .model_selection import make_fillin_cases
 from .preprocessing import make_motion_preprocessor
+from .utils import random_windows
 
 __all__ = ["main"]
 
-# The paper's fill-in experiment: the held-out walk and jog, two body parts.
-TEST_TRIALS = (("walk", "35_29"), ("jog", "35_18"))
-BODY_PARTS = (("left leg", "lfemur"), ("upper body", "lowerback"))
 PAPER_FILLIN = {
     ("walk", "left leg"): (8.78, 11.68),
     ("walk", "upper body"): (20.52, 22.20),
@@ -229,45 +221,16 @@ def run_demo(args):
     imputer.fit(Z, sequence_ids=train.sequence_ids)
     model = imputer.estimator_
 
-    cases = _fillin_cases(preprocessor, train, test, names)
-    table = _fillin_table(preprocessor, imputer, Z, cases, args.n_repeats, args.seed)
-    generated = _generate_styles(model, preprocessor, Z, train, names, args)
+    cases = make_fillin_cases(test, preprocessor)
+    table = _fillin_table(imputer, Z, cases, args.n_repeats, args.seed)
+    generated = _generate_styles(model, Z, train, names, args)
     if not args.no_figures:
         _draw(args.output, model, preprocessor, train, cases, table, generated)
     print(f"\ndone in {time.perf_counter() - start:.0f} s")
     return 0
 
 
-def _fillin_cases(preprocessor, train, test, names):
-    """The paper's cases: erase a body part from halfway to the end."""
-    cases = {}
-    for motion, trial in TEST_TRIALS:
-        raw = test.data[test.sequence_ids == list(test.sequence_names).index(trial)]
-        Z = preprocessor.transform(raw)
-        first = len(Z) - len(Z) // 2
-        for part, top_bone in BODY_PARTS:
-            bones = train.skeleton.descendants(top_bone)
-            mask = np.zeros(Z.shape, dtype=bool)
-            mask[first:, bone_columns(names, bones, strict=False)] = True
-            raw_mask = np.zeros(raw.shape, dtype=bool)
-            raw_mask[first:, bone_columns(train.feature_names, bones, strict=False)] = (
-                True
-            )
-            cases[motion, part] = dict(
-                Z=Z, raw=raw, mask=mask, raw_mask=raw_mask, trial=trial, first=first
-            )
-    return cases
-
-
-def _fillin_errors(preprocessor, case, filled):
-    raw = preprocessor.inverse_transform(filled)
-    return (
-        fillin_error(case["Z"], filled, missing_mask=case["mask"]),
-        fillin_angle_rmse(case["raw"], raw, missing_mask=case["raw_mask"]),
-    )
-
-
-def _fillin_table(preprocessor, imputer, Z_train, cases, n_repeats, seed):
+def _fillin_table(imputer, Z_train, cases, n_repeats, seed):
     nearest = NearestNeighborImputer().fit(Z_train)
     print(
         f"\nfilling in (the paper's error, summed over the erased frames; "
@@ -279,26 +242,24 @@ def _fillin_table(preprocessor, imputer, Z_train, cases, n_repeats, seed):
     )
     table = {}
     for (motion, part), case in cases.items():
-        X_missing = np.where(case["mask"], np.nan, case["Z"])
-        draws = imputer.sample(X_missing, n_samples=n_repeats, random_state=seed)
-        crbm = np.mean([_fillin_errors(preprocessor, case, d) for d in draws], axis=0)
-        nn_fill = nearest.transform(X_missing)
-        nn = _fillin_errors(preprocessor, case, nn_fill)
+        draws = imputer.sample(case.X_missing, n_samples=n_repeats, random_state=seed)
+        crbm = np.mean([case.errors(d) for d in draws], axis=0)
+        nn_fill = nearest.transform(case.X_missing)
+        nn = case.errors(nn_fill)
         paper = PAPER_FILLIN.get((motion, part))
         paper_text = f"{paper[0]:.2f} / {paper[1]:.2f}" if paper else "-"
         print(
-            f"{motion + ' ' + case['trial']:<14}{part:<12}{crbm[0]:8.2f}{nn[0]:8.2f}"
+            f"{motion + ' ' + case.trial:<14}{part:<12}{crbm[0]:8.2f}{nn[0]:8.2f}"
             f"{crbm[0] / nn[0]:7.2f}{crbm[1]:8.2f}{nn[1]:8.2f}   {paper_text}"
         )
         table[motion, part] = dict(crbm=crbm, nn=nn, draw=draws[0], nn_fill=nn_fill)
     return table
 
 
-def _generate_styles(model, preprocessor, Z, train, names, args):
+def _generate_styles(model, Z, train, names, args):
     """Seed with walk frames and with jog frames; classify what comes out."""
     ids = train.sequence_ids
-    styles = np.asarray(train.motion)[ids]
-    reference = _gait_statistics(Z, ids, names)
+    reference = gait_statistics(Z, sequence_ids=ids, feature_names=names)
     reference_styles = np.asarray(train.motion)
     print(
         f"\ngenerating {args.n_frames} frames per sequence, 3 sequences per seed style"
@@ -307,11 +268,17 @@ def _generate_styles(model, preprocessor, Z, train, names, args):
     generated = {}
     rng = np.random.default_rng(args.seed)
     for style in ("walk", "jog"):
-        starts = rng.choice(np.flatnonzero(styles == style), 3, replace=False)
-        seeds = np.stack([_window_before(Z, ids, s, model.order) for s in starts])
+        seeds = random_windows(
+            Z,
+            sequence_ids=ids,
+            width=model.order,
+            n_windows=3,
+            sequences=np.flatnonzero(reference_styles == style),
+            random_state=rng,
+        )
         frames = model.sample(args.n_frames, history=seeds, random_state=args.seed)
         gen_ids = np.repeat(np.arange(3), args.n_frames)
-        stats = _gait_statistics(frames, gen_ids, names)
+        stats = gait_statistics(frames, sequence_ids=gen_ids, feature_names=names)
         labels = nearest_style(stats, reference, reference_styles)
         for row, label in zip(stats, labels, strict=True):
             print(f"{style:<12}{row[0]:8.3f}{row[1]:9.2f}   {label}")
@@ -324,27 +291,6 @@ def _generate_styles(model, preprocessor, Z, train, names, args):
             "   (training mean)"
         )
     return generated
-
-
-def _gait_statistics(X, sequence_ids, names):
-    legs = [
-        n for n in names if n.startswith(("lfemur_", "rfemur_", "ltibia_", "rtibia_"))
-    ]
-    return np.column_stack(
-        [
-            forward_speed(X, sequence_ids=sequence_ids, feature_names=names),
-            step_frequency(
-                X, sequence_ids=sequence_ids, features=legs, feature_names=names
-            ),
-        ]
-    )
-
-
-def _window_before(Z, sequence_ids, frame, order):
-    """``order`` frames of one sequence ending at ``frame`` (moved inside if needed)."""
-    same = np.flatnonzero(sequence_ids == sequence_ids[frame])
-    end = min(max(frame, same[0] + order), same[-1] + 1)
-    return Z[end - order : end]
 
 
 def _draw(output, model, preprocessor, train, cases, table, generated):
@@ -386,12 +332,12 @@ def _draw(output, model, preprocessor, train, cases, table, generated):
     case, result = cases["walk", "left leg"], table["walk", "left leg"]
     names = preprocessor.get_feature_names_out()
     axes = plot_filled_channels(
-        case["Z"],
+        case.X,
         result["draw"],
         result["nn_fill"],
         features=["lfemur_ex", "lfemur_ey", "lfemur_ez"],
         feature_names=names,
-        missing_from=case["first"],
+        missing_from=case.first_missing,
     )
     fig = np.ravel(axes)[0].figure
     written.append(_save(fig, output / "fillin_left_hip.png"))
@@ -462,11 +408,14 @@ def run_sample(args):
     crbm, preprocessor = pipeline[-1], pipeline[:-1]
     train = _load_cmu35(args.data_home, "train")
     Z = preprocessor.transform(train.data, sequence_ids=train.sequence_ids)
-    styles = np.asarray(train.motion)[train.sequence_ids]
-    rng = np.random.default_rng(args.seed)
-    starts = rng.choice(np.flatnonzero(styles == args.style), args.n_sequences)
-    width = max(crbm.order, crbm.hidden_order or crbm.order, 1)
-    seeds = np.stack([_window_before(Z, train.sequence_ids, s, width) for s in starts])
+    seeds = random_windows(
+        Z,
+        sequence_ids=train.sequence_ids,
+        width=max(crbm.order, crbm.hidden_order or crbm.order, 1),
+        n_windows=args.n_sequences,
+        sequences=np.flatnonzero(np.asarray(train.motion) == args.style),
+        random_state=args.seed,
+    )
     frames = crbm.sample(
         args.n_frames,
         history=seeds,

@@ -1,38 +1,26 @@
 """Conditional Restricted Boltzmann Machine (Taylor, Hinton & Roweis, 2006)."""
 
 import time
-from numbers import Integral, Real
+from numbers import Integral
 
 import numpy as np
-from sklearn.base import (
-    BaseEstimator,
-    ClassNamePrefixFeaturesOutMixin,
-    TransformerMixin,
-    _fit_context,
-)
+from sklearn.base import _fit_context
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval, StrOptions
-from sklearn.utils.validation import (
-    _check_sample_weight,
-    check_is_fitted,
-    validate_data,
-)
+from sklearn.utils.validation import validate_data
 
+from ._base import BaseCRBM, FittedParameter
 from ._crbm_math import (
     BINARY,
     CDWorkspace,
     CRBMParameters,
     MomentumUpdate,
     cd_gradients,
-    dynamic_biases,
     free_energy,
-    gibbs_frames,
-    hidden_probabilities,
-    mean_field_prediction,
+    sequence_dynamic_biases,
 )
 from .utils._fitting import unfitted_on_error
-from .utils._parallel import map_sequence_blocks
-from .utils._persistence import VersionedPickleMixin
+from .utils._random import rng_from
 from .utils._sequences import (
     balanced_batches,
     check_sequence_ids,
@@ -40,36 +28,12 @@ from .utils._sequences import (
     shuffled_batches,
 )
 
-# Frames processed at once by transform / score: bounds the gathered history.
-_CHUNK_FRAMES = 4096
-# How many windows of training frames ``fit`` keeps to seed ``sample``.
-_MAX_SEED_WINDOWS = 500
-# Mean-field iterations of the one-step-ahead prediction behind ``score``.
-_SCORE_MEAN_FIELD_STEPS = 10
-# Sequences generated together in one vectorised pass by ``sample``: one
-# frame of 100 sequences costs little more than one of 1, so blocks are large.
-_SAMPLE_BLOCK = 256
-# Standard deviation of the jitter added to the previous frame to start the
-# Gibbs chain of a new frame (REFERENCE.md, gen.m).
-_START_JITTER = 0.01
-
 
 class TrainingDivergedError(FloatingPointError):
     """Training produced non-finite weights (the learning rate is too large)."""
 
 
-def _rng_from(random_state):
-    """A numpy Generator (fast float32 draws) seeded from a sklearn random_state."""
-    seed = check_random_state(random_state).randint(np.iinfo(np.int32).max)
-    return np.random.default_rng(seed)
-
-
-class ConditionalRBM(
-    VersionedPickleMixin,
-    ClassNamePrefixFeaturesOutMixin,
-    TransformerMixin,
-    BaseEstimator,
-):
+class ConditionalRBM(BaseCRBM):
     """Conditional Restricted Boltzmann Machine for sequences of frames.
 
     Models each frame ``v_t`` with visible units (Gaussian with unit variance
@@ -204,32 +168,20 @@ class ConditionalRBM(
     """
 
     _parameter_constraints: dict = {
+        **BaseCRBM._parameter_constraints,
         "n_components": [Interval(Integral, 1, None, closed="left")],
-        "order": [Interval(Integral, 0, None, closed="left")],
-        "hidden_order": [None, Interval(Integral, 0, None, closed="left")],
         "visible_type": [StrOptions({"gaussian", "binary"})],
-        "learning_rate": [Interval(Real, 0, None, closed="neither")],
-        "momentum": [Interval(Real, 0, 1, closed="left")],
-        "momentum_delay": [Interval(Integral, 0, None, closed="left")],
-        "weight_decay": [Interval(Real, 0, None, closed="left")],
-        "cd_steps": [Interval(Integral, 1, None, closed="left")],
-        "batch_size": [Interval(Integral, 1, None, closed="left")],
-        "batching": [StrOptions({"balanced", "shuffled"})],
-        "history_noise": [Interval(Real, 0, None, closed="left")],
-        "n_iter": [Interval(Integral, 1, None, closed="left")],
-        "random_state": ["random_state"],
-        "verbose": ["verbose"],
     }
 
-    # Private state that a failed fit must forget with the fitted attributes.
-    _training_state = ("_velocities",)
+    # Private state that a failed fit must forget with the fitted attributes:
+    # the packed parameters (which the public ones view) and the velocities.
+    _training_state = ("_parameters", "_velocity")
 
-    # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
-    # search passes ``sequence_ids`` to these methods without being asked.
-    __metadata_request__fit = {"sequence_ids": True}
-    __metadata_request__partial_fit = {"sequence_ids": True}
-    __metadata_request__transform = {"sequence_ids": True}
-    __metadata_request__score = {"sequence_ids": True}
+    components_ = FittedParameter("weights")
+    intercept_hidden_ = FittedParameter("hidden_bias")
+    intercept_visible_ = FittedParameter("visible_bias")
+    autoregressive_ = FittedParameter("autoregressive")
+    past_to_hidden_ = FittedParameter("past_to_hidden")
 
     def __init__(
         self,
@@ -324,7 +276,7 @@ class ConditionalRBM(
                 X,
                 dtype=[np.float64, np.float32]
                 if first_call
-                else self.components_.dtype,
+                else self._parameters.dtype,
                 reset=first_call,
             )
             sequences, frames = self._check_sequences(X, sequence_ids)
@@ -333,40 +285,23 @@ class ConditionalRBM(
                 self.random_state_ = check_random_state(self.random_state)
                 self._initialize(X.shape[1], X.dtype)
             self._train(X, frames, 1)
-        new_windows = self._pick_seed_windows(X, sequences)
-        if not first_call:
-            new_windows = self._merge_seed_windows(self.seed_windows_, new_windows)
-        self.seed_windows_ = new_windows
+        self.seed_windows_ = self._merge_seed_windows(
+            self._pick_seed_windows(X, sequences)
+        )
         return self
 
-    def fit_transform(self, X, y=None, *, sequence_ids=None):
-        """Fit, then return the hidden probabilities of ``X``.
+    @property
+    def history_length(self):
+        """Past frames a frame depends on: ``max(order, hidden_order)``.
 
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-
-        Returns
-        -------
-        H : ndarray of shape (n_frames, n_components)
-            Hidden probabilities, as :meth:`transform` gives them.
+        :meth:`sample` needs this many seed frames (at least one), and
+        :meth:`score` judges frames with this many past frames in their
+        sequence.
         """
-        return self.fit(X, sequence_ids=sequence_ids).transform(
-            X, sequence_ids=sequence_ids
-        )
+        return self._n_lags
 
-    @property
-    def _n_lags(self):
-        return max(self.order, self._hidden_order)
-
-    @property
-    def _hidden_order(self):
-        return self.order if self.hidden_order is None else self.hidden_order
+    def _layer_parameters(self):
+        return [self._parameters]
 
     def _check_sequences(self, X, sequence_ids):
         """Validate ids and visible type; return the sequences and trainable frames."""
@@ -397,36 +332,17 @@ class ConditionalRBM(
             self._hidden_order,
             self.visible_type,
             dtype,
-            _rng_from(self.random_state_),
+            rng_from(self.random_state_),
         )
-        self._velocities = [np.zeros_like(a) for a in params.arrays()]
         self.n_iter_ = 0
-        self._store(params)
-
-    def _params(self, dtype=None):
-        """Pack the public fitted attributes for the math module."""
-        return CRBMParameters.from_arrays(
-            self.components_,
-            self.intercept_hidden_,
-            self.intercept_visible_,
-            self.autoregressive_,
-            self.past_to_hidden_,
-            self.visible_type,
-            dtype=dtype,
-        )
-
-    def _store(self, params):
-        self.components_ = params.weights
-        self.intercept_hidden_ = params.hidden_bias
-        self.intercept_visible_ = params.visible_bias
-        self.autoregressive_ = params.autoregressive()
-        self.past_to_hidden_ = params.past_to_hidden()
+        self._parameters = params
+        self._velocity = params.zeros_like(layout="F")
 
     def _train(self, X, frames, n_epochs):
-        params = self._params()
-        # params' arrays become views of one buffer, updated in place
-        update = MomentumUpdate(params, self._velocities)
-        self._velocities = list(update.velocities)
+        # trained in the layout BLAS runs fastest, kept in C order when fitted
+        params = self._parameters.copy(layout="F")
+        update = MomentumUpdate(params, self._velocity)
+        self._velocity = update.velocity
         # Minibatches gather rows: from a Fortran-ordered X (what many
         # transformers return) every row would be a strided read.
         X = np.ascontiguousarray(X)
@@ -438,7 +354,7 @@ class ConditionalRBM(
         workspace = CDWorkspace(params, self.batch_size)
         start = time.perf_counter()
         for _ in range(n_epochs):
-            rng = _rng_from(self.random_state_)
+            rng = rng_from(self.random_state_)
             momentum = self.momentum if self.n_iter_ >= self.momentum_delay else 0.0
             squared_error = 0.0
             for batch in plan_batches(frames, self.batch_size, rng):
@@ -468,7 +384,7 @@ class ConditionalRBM(
             self.n_iter_ += 1
             self.reconstruction_error_ = squared_error / len(frames)
             if not params.is_finite() or not np.isfinite(squared_error):
-                self._store(_c_ordered(params))
+                self._parameters = params.copy(layout="C")
                 raise TrainingDivergedError(
                     f"Training diverged at epoch {self.n_iter_}: the weights became "
                     f"non-finite with learning_rate={self.learning_rate}. Lower the "
@@ -481,72 +397,7 @@ class ConditionalRBM(
                     f"reconstruction error = {self.reconstruction_error_:.4f}, "
                     f"time = {time.perf_counter() - start:.2f}s"
                 )
-        self._store(_c_ordered(params))
-
-    def _pick_seed_windows(self, X, sequences):
-        """Keep up to ``_MAX_SEED_WINDOWS`` evenly spaced windows of real frames.
-
-        Deterministic (no random draws), so that seeding ``sample`` does not
-        disturb the training random stream.
-        """
-        width = max(self._n_lags, 1)
-        ends = _evenly_spaced(sequences.valid_frames(width - 1) + 1, _MAX_SEED_WINDOWS)
-        rows = ends[:, None] - np.arange(width, 0, -1)
-        return X[rows].astype(self.components_.dtype, copy=True)
-
-    @staticmethod
-    def _merge_seed_windows(old, new):
-        windows = np.concatenate((old, new))
-        return windows[_evenly_spaced(np.arange(len(windows)), _MAX_SEED_WINDOWS)]
-
-    # ------------------------------------------------------------ inference
-
-    def _check_inference_input(self, X, sequence_ids):
-        check_is_fitted(self)
-        X = validate_data(self, X, dtype=[np.float64, np.float32], reset=False)
-        X = X.astype(self.components_.dtype, copy=False)
-        return X, check_sequence_ids(sequence_ids, X.shape[0])
-
-    def _iter_dynamic_biases(self, params, X, sequences, frames=None, padded=True):
-        """Yield ``(rows, visible_bias, hidden_bias)`` chunk by chunk.
-
-        With ``padded=True`` a lag reaching before the start of a sequence
-        reads the sequence's first frame instead.
-        """
-        frames = np.arange(X.shape[0]) if frames is None else frames
-        starts = sequences.frame_starts() if padded else None
-        for lo in range(0, len(frames), _CHUNK_FRAMES):
-            rows = frames[lo : lo + _CHUNK_FRAMES]
-            history = frame_history(
-                X, rows, params.n_lags, None if starts is None else starts[rows]
-            )
-            yield (rows, *dynamic_biases(params, history))
-
-    def transform(self, X, *, sequence_ids=None):
-        """Hidden probabilities ``p(h = 1 | x_t, history)`` of every frame.
-
-        For the first ``max(order, hidden_order)`` frames of each sequence the
-        missing past frames are replaced by the sequence's first frame (edge
-        padding), so every frame gets a row.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-
-        Returns
-        -------
-        H : ndarray of shape (n_frames, n_components)
-            Hidden probabilities, in the dtype of the model.
-        """
-        X, sequences = self._check_inference_input(X, sequence_ids)
-        params = self._params()
-        hidden = np.empty((X.shape[0], self.n_components), dtype=X.dtype)
-        for rows, _, hidden_bias in self._iter_dynamic_biases(params, X, sequences):
-            hidden[rows] = hidden_probabilities(params, X[rows], hidden_bias)
-        return hidden
+        self._parameters = params.copy(layout="C")
 
     def score_samples(self, X, *, sequence_ids=None):
         """Negative free energy ``-F(x_t | history)`` of every frame.
@@ -571,299 +422,10 @@ class ConditionalRBM(
             Negative free energy of each frame.
         """
         X, sequences = self._check_inference_input(X, sequence_ids)
-        params = self._params()
+        params = self._parameters
         scores = np.empty(X.shape[0], dtype=X.dtype)
-        for rows, visible_bias, hidden_bias in self._iter_dynamic_biases(
+        for rows, visible_bias, hidden_bias in sequence_dynamic_biases(
             params, X, sequences
         ):
             scores[rows] = -free_energy(params, X[rows], visible_bias, hidden_bias)
         return scores
-
-    def predict_next(self, X, *, sequence_ids=None):
-        """One-step-ahead prediction of every frame from its history alone.
-
-        The prediction is a deterministic estimate of ``E[x_t | history]``:
-        starting from the autoregressive mean, hidden probabilities and
-        visible means are alternated ten times (mean field).  The frame
-        itself is not used.  For the first ``max(order, hidden_order)`` frames
-        of each sequence the missing past frames are replaced by the
-        sequence's first frame (edge padding).
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-
-        Returns
-        -------
-        X_pred : ndarray of shape (n_frames, n_features)
-            Predicted frames.
-        """
-        X, sequences = self._check_inference_input(X, sequence_ids)
-        return self._predict_frames(self._params(), X, sequences)
-
-    def _predict_frames(self, params, X, sequences, frames=None):
-        frames = np.arange(X.shape[0]) if frames is None else frames
-        predicted = np.empty((len(frames), X.shape[1]), dtype=X.dtype)
-        position = 0
-        for rows, visible_bias, hidden_bias in self._iter_dynamic_biases(
-            params, X, sequences, frames
-        ):
-            predicted[position : position + len(rows)] = mean_field_prediction(
-                params, visible_bias, hidden_bias, _SCORE_MEAN_FIELD_STEPS
-            )
-            position += len(rows)
-        return predicted
-
-    def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
-        """Negative one-step-ahead prediction error; higher is better.
-
-        The mean, over every frame that has a complete history in its own
-        sequence and over features, of the squared difference between the
-        frame and :meth:`predict_next`'s prediction from its history.  It is
-        measured in the units of ``X`` (standardised data: fractions of a
-        standard deviation), so models with any ``n_components``, ``order``
-        or ``hidden_order`` can be compared on held-out sequences, e.g. by
-        ``GridSearchCV(scoring=None)``.  A model without history
-        (``order=0``) predicts the same frame everywhere and scores like a
-        constant prediction.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-        sample_weight : array-like of shape (n_frames,), default=None
-            Weight of each frame in the mean; frames without a full history
-            are left out whatever their weight.
-
-        Returns
-        -------
-        score : float
-            Negative mean squared one-step-ahead prediction error.
-        """
-        X, sequences = self._check_inference_input(X, sequence_ids)
-        frames = sequences.valid_frames(self._n_lags)
-        if len(frames) == 0:
-            raise ValueError(
-                f"score needs frames with {self._n_lags} past frames in their own "
-                "sequence; every sequence given is shorter. Pass longer sequences."
-            )
-        weights = None
-        if sample_weight is not None:
-            weights = _check_sample_weight(sample_weight, X)[frames]
-        predicted = self._predict_frames(self._params(), X, sequences, frames)
-        errors = np.mean(np.square(X[frames] - predicted), axis=1)
-        return -float(np.average(errors, weights=weights))
-
-    # ----------------------------------------------------------- generation
-
-    def sample(
-        self,
-        n_samples,
-        *,
-        history=None,
-        n_sequences=1,
-        n_gibbs=30,
-        hidden_noise=0.0,
-        sample_visibles=False,
-        random_state=None,
-        n_jobs=None,
-    ):
-        """Generate new frames by alternating Gibbs sampling (paper §4).
-
-        Each new frame starts from the previous frame plus N(0, 0.01^2)
-        jitter; ``n_gibbs`` alternating Gibbs iterations follow (hidden units
-        sampled, visibles set to their mean), then one mean-field step with
-        hidden probabilities.  All sequences are generated together.
-
-        Parameters
-        ----------
-        n_samples : int
-            Number of new frames per sequence.
-        history : array-like, default=None
-            Seed frames, oldest first: shape ``(n_frames, n_features)`` seeds
-            every sequence with its last ``max(order, hidden_order, 1)`` rows;
-            shape ``(n_sequences, n_frames, n_features)`` gives each sequence
-            its own seed.  ``None`` draws windows of real training frames kept
-            by :meth:`fit` (``seed_windows_``).
-        n_sequences : int, default=1
-            Number of sequences to generate; with a 3-D ``history`` it is
-            taken from the history.
-        n_gibbs : int, default=30
-            Alternating Gibbs iterations per frame.
-        hidden_noise : float, default=0.0
-            Standard deviation of Gaussian noise added to the hidden biases
-            each time hidden states are chosen (paper §4.3: transitions
-            between styles).
-        sample_visibles : bool, default=False
-            If True, the visibles are drawn from ``p(v | h, history)`` at every
-            Gibbs step (Gaussian noise of unit variance, or binary states) and
-            each new frame is the last draw: an exact Gibbs sampler whose
-            frames follow ``p(x_t | history)`` when ``n_gibbs`` is large.  The
-            default keeps the original code's scheme (visible means, then a
-            mean-field step), which gives smoother motion.
-        random_state : int, RandomState instance or None, default=None
-            Seeds the generation; ``None`` uses the estimator's
-            ``random_state``, so repeated calls give the same frames when
-            that is an int.
-        n_jobs : int, default=None
-            Number of jobs generating blocks of 256 sequences in parallel
-            (joblib; ``None`` means 1 unless in a
-            :obj:`joblib.parallel_backend` context).  Up to 256 sequences are
-            generated together in one vectorised pass; the blocks and their
-            random streams depend on ``n_sequences`` only, so the frames are
-            the same for any ``n_jobs``.
-
-        Returns
-        -------
-        X_new : ndarray of shape (n_sequences * n_samples, n_features)
-            The generated frames only (not the seed), in long format:
-            rows ``k * n_samples`` to ``(k + 1) * n_samples - 1`` are
-            sequence ``k``.
-        """
-        check_is_fitted(self)
-        n_samples = _check_count(n_samples, "n_samples", minimum=1)
-        n_gibbs = _check_count(n_gibbs, "n_gibbs", minimum=0)
-        n_sequences = _check_count(n_sequences, "n_sequences", minimum=1)
-        if not isinstance(hidden_noise, Real) or not hidden_noise >= 0:
-            raise ValueError(
-                f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
-            )
-        rng = _rng_from(self.random_state if random_state is None else random_state)
-        seed = seed_frames(
-            history,
-            n_sequences,
-            width=max(self._n_lags, 1),
-            n_features=self.n_features_in_,
-            dtype=self.components_.dtype,
-            seed_windows=self.seed_windows_,
-            rng=rng,
-        )
-        params = self._params()
-
-        def generate_block(block, block_rng):
-            return self._generate(
-                params,
-                seed[block],
-                n_samples,
-                n_gibbs,
-                hidden_noise,
-                sample_visibles,
-                block_rng,
-            )
-
-        blocks = map_sequence_blocks(
-            generate_block, len(seed), rng, n_jobs, block_size=_SAMPLE_BLOCK
-        )
-        return np.concatenate(blocks).reshape(-1, self.n_features_in_)
-
-    def _generate(
-        self, params, seed, n_samples, n_gibbs, hidden_noise, sample_visibles, rng
-    ):
-        n_sequences, width, n_features = seed.shape
-        n_lags = params.n_lags
-        frames = np.empty(
-            (n_sequences, width + n_samples, n_features), dtype=seed.dtype
-        )
-        frames[:, :width] = seed
-        for t in range(width, width + n_samples):
-            history = frames[:, t - n_lags : t][:, ::-1].reshape(
-                n_sequences, n_lags * n_features
-            )
-            visible_bias, hidden_bias = dynamic_biases(params, history)
-            start = frames[:, t - 1] + _START_JITTER * rng.standard_normal(
-                (n_sequences, n_features), dtype=seed.dtype
-            )
-            frames[:, t] = gibbs_frames(
-                params,
-                start,
-                visible_bias,
-                hidden_bias,
-                n_gibbs,
-                rng,
-                hidden_noise=hidden_noise,
-                sample_visibles=sample_visibles,
-            )
-        return frames[:, width:]
-
-    # ---------------------------------------------------------------- misc
-
-    @property
-    def _n_features_out(self):
-        return self.components_.shape[0]
-
-    def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.transformer_tags.preserves_dtype = ["float64", "float32"]
-        return tags
-
-
-def _c_ordered(params):
-    """``params`` with arrays of their own (2-D ones in C order), as fitted.
-
-    During training they are views of one buffer (``MomentumUpdate``).
-    """
-    params.weights = np.ascontiguousarray(params.weights)
-    params.dynamic = np.ascontiguousarray(params.dynamic)
-    params.hidden_bias = params.hidden_bias.copy()
-    params.visible_bias = params.visible_bias.copy()
-    return params
-
-
-def seed_frames(history, n_sequences, *, width, n_features, dtype, seed_windows, rng):
-    """Check a ``sample`` history; seeds of shape (n_sequences, width, n_features).
-
-    ``None`` draws windows of real training frames from ``seed_windows``; a
-    2-D history seeds every sequence with its last ``width`` rows; a 3-D one
-    gives one seed per sequence.  Oldest frame first.
-    """
-    if history is None:
-        picks = rng.integers(len(seed_windows), size=n_sequences)
-        return seed_windows[picks]
-    if hasattr(history, "toarray") or hasattr(history, "tocsr"):
-        raise TypeError("history must be a dense array, got a sparse matrix.")
-    try:
-        history = np.asarray(history, dtype=dtype)
-    except (TypeError, ValueError) as exc:
-        raise TypeError(
-            f"history must be an array of numbers, got {type(history).__name__}."
-        ) from exc
-    if history.ndim == 2:
-        history = np.broadcast_to(history, (n_sequences, *history.shape))
-    elif history.ndim == 3:
-        if n_sequences not in (1, history.shape[0]):
-            raise ValueError(
-                f"history holds {history.shape[0]} seeds but n_sequences="
-                f"{n_sequences}; give one seed per sequence or a 2-D history."
-            )
-    else:
-        raise ValueError(
-            "history must have shape (n_frames, n_features) or (n_sequences, "
-            f"n_frames, n_features), got shape {history.shape}."
-        )
-    if history.shape[2] != n_features or history.shape[1] < width:
-        raise ValueError(
-            f"history must hold at least {width} frames of {n_features} features "
-            f"each, got shape {history.shape}."
-        )
-    if not np.isfinite(history).all():
-        raise ValueError("history contains NaN or infinity.")
-    return np.ascontiguousarray(history[:, -width:])
-
-
-def _evenly_spaced(values, at_most):
-    if len(values) <= at_most:
-        return values
-    return values[np.linspace(0, len(values) - 1, at_most).round().astype(np.intp)]
-
-
-def _check_count(value, name, minimum):
-    if isinstance(value, bool) or not isinstance(value, Integral) or value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}.")
-    return int(value)

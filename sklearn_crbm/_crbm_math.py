@@ -27,8 +27,12 @@ N(c_hat + W.T h, I)``.  With binary visibles the quadratic term becomes
 """
 
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
+
+from .utils._sequences import frame_history
 
 GAUSSIAN = "gaussian"
 BINARY = "binary"
@@ -84,44 +88,146 @@ def logistic(activation, out=None):
     return np.reciprocal(out, out=out)
 
 
-class CRBMParameters:
-    """Packed parameters of one CRBM, in the layout the math works on.
+def _small_normal(rng, shape, dtype):
+    return (0.01 * rng.standard_normal(shape)).astype(dtype, copy=False)
+
+
+@dataclass(frozen=True)
+class ParameterGroup:
+    """One trainable array of a CRBM: its shape, start value and penalty.
 
     Parameters
     ----------
-    weights : ndarray of shape (n_components, n_features)
-    hidden_bias : ndarray of shape (n_components,)
-    visible_bias : ndarray of shape (n_features,)
-    dynamic : ndarray of shape (n_features + n_components, n_lags * n_features)
-    order, hidden_order : int
+    name : str
+        Attribute of :class:`CRBMParameters` that views it.
+    shape : callable
+        ``shape(params)`` gives its shape from ``n_features``,
+        ``n_components`` and ``n_lags``.
+    initial : callable
+        ``initial(params, rng)`` gives its start value (float64 or the
+        parameters' dtype); ``rng`` draws in the order of ``GROUPS``.
+    decayed : bool
+        Whether weight decay applies to it.
+    """
+
+    name: str
+    shape: Callable
+    initial: Callable
+    decayed: bool
+
+
+def _initial_dynamic(params, rng):
+    return (
+        _small_normal(rng, params.dynamic.shape, params.dtype) * params.dynamic_mask()
+    )
+
+
+# Every trainable array, in the order its start value is drawn.  A new group
+# (say, learned visible variances) is one entry here: storage, views,
+# momentum, decay, pickling and the statistics buffers follow from it; its
+# gradient goes into ``cd_gradients`` and its public name onto the estimator.
+GROUPS = (
+    ParameterGroup(
+        "dynamic",
+        lambda p: (p.n_features + p.n_components, p.n_lags * p.n_features),
+        _initial_dynamic,
+        decayed=True,
+    ),
+    ParameterGroup(
+        "weights",
+        lambda p: (p.n_components, p.n_features),
+        lambda p, rng: _small_normal(rng, p.weights.shape, p.dtype),
+        decayed=True,
+    ),
+    ParameterGroup(
+        "hidden_bias",
+        lambda p: (p.n_components,),
+        # hidden units start mostly off
+        lambda p, rng: _small_normal(rng, p.hidden_bias.shape, p.dtype) - 1,
+        decayed=False,
+    ),
+    ParameterGroup(
+        "visible_bias",
+        lambda p: (p.n_features,),
+        lambda p, rng: _small_normal(rng, p.visible_bias.shape, p.dtype),
+        decayed=False,
+    ),
+)
+
+
+class CRBMParameters:
+    """Every trainable array of one CRBM, packed in one flat buffer.
+
+    Each group of :data:`GROUPS` is an attribute viewing its part of
+    :attr:`flat`: ``weights`` ``W`` (n_components, n_features),
+    ``hidden_bias`` (n_components,), ``visible_bias`` (n_features,) and
+    ``dynamic`` (n_features + n_components, n_lags * n_features), the
+    directed weights ``[A; B]`` (see the module docstring).  The decayed
+    groups come first, so weight decay is one pass over a prefix of
+    :attr:`flat`, and a momentum update one pass over all of it.  The
+    estimators' fitted attributes are views of the same buffer.
+
+    Parameters
+    ----------
+    n_features, n_components, order, hidden_order : int
     visible_type : {"gaussian", "binary"}
+    dtype : dtype
+    flat : ndarray of shape (n_parameters,), default=None
+        The buffer to view; zeros if None.
+    layout : {"C", "F"}, default="C"
+        Memory order of the 2-D groups inside ``flat``.  Training works in
+        "F", the orientation in which BLAS runs its products fastest;
+        fitted models keep "C" (the same numbers, but a matrix-vector
+        product rounds differently in the two orders).
+
+    Attributes
+    ----------
+    flat : ndarray of shape (n_parameters,)
+    weights, hidden_bias, visible_bias, dynamic : ndarray
+        Views of ``flat``.
     """
 
     def __init__(
         self,
-        weights,
-        hidden_bias,
-        visible_bias,
-        dynamic,
+        n_features,
+        n_components,
         order,
         hidden_order,
         visible_type,
+        dtype,
+        *,
+        flat=None,
+        layout="C",
     ):
-        self.weights = weights
-        self.hidden_bias = hidden_bias
-        self.visible_bias = visible_bias
-        self.dynamic = dynamic
+        self.n_features = n_features
+        self.n_components = n_components
         self.order = order
         self.hidden_order = hidden_order
         self.visible_type = visible_type
+        self.layout = layout
+        shapes = [group.shape(self) for group in GROUPS]
+        size = sum(math.prod(shape) for shape in shapes)
+        self.flat = np.zeros(size, dtype) if flat is None else flat
+        self._bind(shapes)
 
-    @property
-    def n_features(self):
-        return self.weights.shape[1]
+    def _bind(self, shapes=None):
+        shapes = [group.shape(self) for group in GROUPS] if shapes is None else shapes
+        for name, view in self.views(self.flat, shapes).items():
+            setattr(self, name, view)
 
-    @property
-    def n_components(self):
-        return self.weights.shape[0]
+    def views(self, flat, shapes=None):
+        """``{group name: view}`` of a buffer laid out like :attr:`flat`."""
+        shapes = [group.shape(self) for group in GROUPS] if shapes is None else shapes
+        views, offset = {}, 0
+        for group, shape in sorted(
+            zip(GROUPS, shapes, strict=True), key=lambda pair: not pair[0].decayed
+        ):
+            size = math.prod(shape)
+            views[group.name] = flat[offset : offset + size].reshape(
+                shape, order=self.layout
+            )
+            offset += size
+        return views
 
     @property
     def n_lags(self):
@@ -129,7 +235,13 @@ class CRBMParameters:
 
     @property
     def dtype(self):
-        return self.weights.dtype
+        return self.flat.dtype
+
+    @property
+    def decayed(self):
+        """The prefix of :attr:`flat` that weight decay applies to."""
+        size = sum(getattr(self, g.name).size for g in GROUPS if g.decayed)
+        return slice(0, size)
 
     @classmethod
     def initialize(
@@ -140,69 +252,45 @@ class CRBMParameters:
         ``W``, ``A``, ``B`` and the visible bias are N(0, 0.01^2); the hidden
         bias is -1 + N(0, 0.01^2) so that hidden units start mostly off.
         """
-        n_lags = max(order, hidden_order)
-
-        def normal(*shape):
-            return (0.01 * rng.standard_normal(shape)).astype(dtype, copy=False)
-
-        dynamic = normal(n_features + n_components, n_lags * n_features)
-        params = cls(
-            weights=normal(n_components, n_features),
-            hidden_bias=(normal(n_components) - 1).astype(dtype, copy=False),
-            visible_bias=normal(n_features),
-            dynamic=dynamic,
-            order=order,
-            hidden_order=hidden_order,
-            visible_type=visible_type,
-        )
-        params.dynamic *= params.dynamic_mask()
+        params = cls(n_features, n_components, order, hidden_order, visible_type, dtype)
+        for group in GROUPS:
+            getattr(params, group.name)[...] = group.initial(params, rng)
         return params
 
-    @classmethod
-    def from_arrays(
-        cls,
-        components,
-        intercept_hidden,
-        intercept_visible,
-        autoregressive,
-        past_to_hidden,
-        visible_type,
-        dtype=None,
-    ):
-        """Pack the public 3-D directed weights into one ``dynamic`` matrix."""
-        dtype = components.dtype if dtype is None else dtype
-        n_components, n_features = components.shape
-        order, hidden_order = len(autoregressive), len(past_to_hidden)
-        n_lags = max(order, hidden_order)
-        dynamic = np.zeros(
-            (n_features + n_components, n_lags * n_features), dtype=dtype
-        )
-        dynamic[:n_features, : order * n_features] = _lag_blocks_to_matrix(
-            autoregressive
-        )
-        dynamic[n_features:, : hidden_order * n_features] = _lag_blocks_to_matrix(
-            past_to_hidden
-        )
-        return cls(
-            weights=np.asarray(components, dtype=dtype),
-            hidden_bias=np.asarray(intercept_hidden, dtype=dtype),
-            visible_bias=np.asarray(intercept_visible, dtype=dtype),
-            dynamic=dynamic,
-            order=order,
-            hidden_order=hidden_order,
-            visible_type=visible_type,
+    def copy(self, layout=None):
+        """The same values in a new buffer (laid out ``layout``, default the same)."""
+        new = self.zeros_like(layout)
+        for name, view in new.views(new.flat).items():
+            view[...] = getattr(self, name)
+        return new
+
+    def zeros_like(self, layout=None):
+        """Parameters of the same shape, all zero: velocities, gradients."""
+        return type(self)(
+            self.n_features,
+            self.n_components,
+            self.order,
+            self.hidden_order,
+            self.visible_type,
+            self.dtype,
+            layout=self.layout if layout is None else layout,
         )
 
+    @property
     def autoregressive(self):
-        """A as ``(order, n_features, n_features)``; block ``q-1`` acts on x[t-q]."""
-        n = self.n_features
-        return _matrix_to_lag_blocks(self.dynamic[:n, : self.order * n], self.order, n)
+        """``A`` as a view of shape ``(order, n_features, n_features)``.
 
+        Block ``q - 1`` acts on ``x[t - q]``.
+        """
+        n = self.n_features
+        return _lag_blocks(self.dynamic[:n, : self.order * n], self.order, n)
+
+    @property
     def past_to_hidden(self):
-        """``B`` as ``(hidden_order, n_components, n_features)``."""
+        """``B`` as a view of shape ``(hidden_order, n_components, n_features)``."""
         n = self.n_features
         block = self.dynamic[n:, : self.hidden_order * n]
-        return _matrix_to_lag_blocks(block, self.hidden_order, n)
+        return _lag_blocks(block, self.hidden_order, n)
 
     def dynamic_mask(self):
         """1 where a directed weight exists, 0 on the lags a group does not use."""
@@ -212,23 +300,26 @@ class CRBMParameters:
         mask[n:, : self.hidden_order * n] = 1
         return mask
 
-    def arrays(self):
-        """The trainable arrays, in the order gradients are returned."""
-        return (self.weights, self.hidden_bias, self.visible_bias, self.dynamic)
-
     def is_finite(self):
-        return all(np.isfinite(a).all() for a in self.arrays())
+        return bool(np.isfinite(self.flat).all())
+
+    def __getstate__(self):
+        # the views would be pickled as copies: keep the buffer, view it again
+        state = dict(vars(self))
+        for group in GROUPS:
+            del state[group.name]
+        return state
+
+    def __setstate__(self, state):
+        vars(self).update(state)
+        self._bind()
 
 
-def _lag_blocks_to_matrix(blocks):
-    """(q, rows, n) -> (rows, q * n) with block ``q-1`` in columns ``(q-1)n : qn``."""
-    q, rows, n = blocks.shape
-    return np.transpose(blocks, (1, 0, 2)).reshape(rows, q * n)
-
-
-def _matrix_to_lag_blocks(matrix, q, n):
-    rows = matrix.shape[0]
-    return np.ascontiguousarray(np.transpose(matrix.reshape(rows, q, n), (1, 0, 2)))
+def _lag_blocks(matrix, q, n):
+    """(rows, q * n) -> a (q, rows, n) view; block ``q-1`` is columns ``(q-1)n:qn``."""
+    blocks = matrix.view()
+    blocks.shape = (matrix.shape[0], q, n)  # raises rather than copy
+    return blocks.transpose(1, 0, 2)
 
 
 def dynamic_biases(params, history, out=None):
@@ -258,6 +349,51 @@ def dynamic_biases(params, history, out=None):
         np.matmul(history, params.dynamic.T, out=out)
         out += static
     return out[:, :n], out[:, n:]
+
+
+# Frames whose histories are gathered at once by sequence_dynamic_biases:
+# bounds the memory of transform, score and friends on long data.
+CHUNK_FRAMES = 4096
+
+
+def sequence_dynamic_biases(params, X, sequences, frames=None):
+    """Yield ``(rows, visible_bias, hidden_bias)`` of frames of ``X``, chunk by chunk.
+
+    The dynamic biases ``c_hat`` and ``b_hat`` of every frame in ``frames``
+    (default: all) given its past frames in its own sequence; a lag reaching
+    before the start of a sequence reads the sequence's first frame instead
+    (edge padding).
+
+    Parameters
+    ----------
+    params : CRBMParameters
+    X : ndarray of shape (n_frames, n_features)
+        Long format.
+    sequences : Sequences
+        From :func:`~sklearn_crbm.utils._sequences.check_sequence_ids`.
+    frames : ndarray of int, default=None
+
+    Yields
+    ------
+    rows : ndarray of int
+        Up to ``CHUNK_FRAMES`` entries of ``frames``.
+    visible_bias : ndarray of shape (len(rows), n_features)
+    hidden_bias : ndarray of shape (len(rows), n_components)
+    """
+    frames = np.arange(X.shape[0]) if frames is None else frames
+    starts = sequences.frame_starts()
+    for lo in range(0, len(frames), CHUNK_FRAMES):
+        rows = frames[lo : lo + CHUNK_FRAMES]
+        history = frame_history(X, rows, params.n_lags, starts[rows])
+        yield (rows, *dynamic_biases(params, history))
+
+
+def sequence_hidden_probabilities(params, X, sequences):
+    """``p(h = 1 | x_t, history)`` of every frame of ``X``, edge padded."""
+    hidden = np.empty((X.shape[0], params.n_components), dtype=X.dtype)
+    for rows, _, hidden_bias in sequence_dynamic_biases(params, X, sequences):
+        hidden[rows] = hidden_probabilities(params, X[rows], hidden_bias)
+    return hidden
 
 
 def hidden_probabilities(params, visible, hidden_bias, out=None):
@@ -413,80 +549,53 @@ class CDWorkspace:
 
 
 class MomentumUpdate:
-    """Parameters, velocities and statistics of one CRBM in flat buffers.
+    """Velocities and statistics of one CRBM, laid out like its parameters.
 
     After every minibatch training applies (the original code's update)::
 
-        velocity = momentum * velocity + statistic         (all arrays)
-        velocity -= learning_rate * weight_decay * param   (W, A and B only)
+        velocity = momentum * velocity + statistic         (all groups)
+        velocity -= learning_rate * weight_decay * param   (decayed groups)
         param += velocity
 
     where ``statistic`` is ``learning_rate / n`` times the CD gradient
-    (:func:`cd_gradients` writes it into :attr:`statistics`).  The
-    constructor copies ``params`` and ``velocities`` into flat buffers laid
-    out alike (``W`` and ``dynamic`` first, in Fortran order, the orientation
-    in which BLAS runs these products fastest, then the biases) and points
-    ``params``'s arrays at views of the first, so that each line above is
-    one or two numpy passes over a whole buffer instead of several per array.
+    (:func:`cd_gradients` writes it into :attr:`statistics`).  Parameters,
+    velocities and statistics are :class:`CRBMParameters` with one layout,
+    so each line above is one or two numpy passes over a whole buffer.
 
     Parameters
     ----------
     params : CRBMParameters
-        Its arrays are replaced by views of :attr:`parameters`.
-    velocities : sequence of ndarray
-        Shaped like ``params.arrays()``.
+        Updated in place.
+    velocity : CRBMParameters, default=None
+        Laid out like ``params``; zeros if None.
 
     Attributes
     ----------
-    parameters, velocity : ndarray of shape (n_parameters,)
-    velocities, statistics : tuple of ndarray
-        Views of :attr:`velocity` and of a scratch buffer, shaped like
-        ``params.arrays()``.
+    params, velocity, statistics : CRBMParameters
     """
 
-    _ARRAYS = ("weights", "hidden_bias", "visible_bias", "dynamic")
-    _LAYOUT = ("weights", "dynamic", "hidden_bias", "visible_bias")  # decayed first
-
-    def __init__(self, params, velocities):
-        shapes = [getattr(params, name).shape for name in self._LAYOUT]
-        sizes = [math.prod(shape) for shape in shapes]
-        ends = np.cumsum(sizes)
-        self.parameters = np.empty(ends[-1], params.dtype)
-        self.velocity = np.empty_like(self.parameters)
-        self._statistic = np.empty_like(self.parameters)
-        self._decayed = slice(0, int(ends[1]))
-
-        def views(flat):
-            views = {
-                name: flat[end - size : end].reshape(shape, order="F")
-                for name, shape, size, end in zip(
-                    self._LAYOUT, shapes, sizes, ends, strict=True
-                )
-            }
-            return tuple(views[name] for name in self._ARRAYS)
-
-        parameters = views(self.parameters)
-        for name, array in zip(self._ARRAYS, parameters, strict=True):
-            array[...] = getattr(params, name)
-            setattr(params, name, array)
-        for array, value in zip(views(self.velocity), velocities, strict=True):
-            array[...] = value
-        self.velocities = views(self.velocity)
-        self.statistics = views(self._statistic)
+    def __init__(self, params, velocity=None):
+        self.params = params
+        self.velocity = params.zeros_like() if velocity is None else velocity
+        if self.velocity.layout != params.layout:
+            self.velocity = self.velocity.copy(params.layout)
+        self.statistics = params.zeros_like()
+        self._decayed = params.decayed
 
     def apply(self, momentum, learning_rate, weight_decay):
         """Fold :attr:`statistics` into the velocities and those into the parameters."""
-        velocity, statistic = self.velocity, self._statistic
+        velocity, statistic = self.velocity.flat, self.statistics.flat
+        parameters = self.params.flat
         velocity *= momentum
         velocity += statistic
         if weight_decay:  # the statistics are spent: their buffer is scratch
             decay = np.multiply(
-                self.parameters[self._decayed],
+                parameters[self._decayed],
                 learning_rate * weight_decay,
                 out=statistic[self._decayed],
             )
             velocity[self._decayed] -= decay
-        self.parameters += velocity
+        parameters += velocity
 
 
 def cd_gradients(
@@ -523,19 +632,17 @@ def cd_gradients(
     history : ndarray of shape (n, n_lags * n_features)
     cd_steps : int
     rng : numpy.random.Generator
-    out : tuple of ndarray, default=None
-        Arrays shaped like ``params.arrays()`` that receive ``scale *
-        gradient`` (new arrays if None).
+    out : CRBMParameters, default=None
+        Receives ``scale * gradient`` group by group (new if None).
     scale : float
     workspace : CDWorkspace, default=None
         Buffers for minibatches of at least ``n`` frames.
 
     Returns
     -------
-    gradients : tuple of ndarray
-        Sums over the batch (not means) for ``weights``, ``hidden_bias``,
-        ``visible_bias`` and ``dynamic``, in the order of
-        ``CRBMParameters.arrays``; ascent directions (``out`` if given).
+    gradients : CRBMParameters
+        Sums over the batch (not means), group by group; ascent directions
+        (``out`` if given).
     squared_error : float
         Sum over the batch of ``||v - v_recon||^2``.
     """
@@ -543,7 +650,7 @@ def cd_gradients(
     if workspace is None:
         workspace = CDWorkspace(params, n)
     if out is None:
-        out = tuple(np.zeros_like(a) for a in params.arrays())
+        out = params.zeros_like()
     stacked_visible = workspace.visible_stack[: 2 * n]
     stacked_hidden = workspace.hidden_stack[: 2 * n]
     data, reconstruction = stacked_visible[:n], stacked_visible[n:]
@@ -583,15 +690,14 @@ def cd_gradients(
     data *= scale
     np.multiply(reconstruction, -scale, out=reconstruction)
     delta *= scale
-    weights_statistic, hidden_statistic, visible_statistic, dynamic_statistic = out
-    np.matmul(stacked_hidden.T, stacked_visible, out=weights_statistic)
+    np.matmul(stacked_hidden.T, stacked_visible, out=out.weights)
     bias_sums = np.dot(workspace.ones[:n], delta, out=workspace.bias_sums)
-    visible_statistic[...] = bias_sums[:d]
-    hidden_statistic[...] = bias_sums[d:]
+    out.visible_bias[...] = bias_sums[:d]
+    out.hidden_bias[...] = bias_sums[d:]
     if params.n_lags:
-        np.matmul(delta.T, history, out=dynamic_statistic)
+        np.matmul(delta.T, history, out=out.dynamic)
         if workspace.dynamic_mask is not None:
-            dynamic_statistic *= workspace.dynamic_mask
+            out.dynamic *= workspace.dynamic_mask
     return out, squared_error
 
 
@@ -678,18 +784,26 @@ def mean_field_prediction(params, visible_bias, hidden_bias, n_steps):
 
 
 def stacked_gibbs_frames(
-    layers, start, visible_biases, hidden_biases, n_gibbs, rng, *, observed_mask=None
+    layers,
+    start,
+    visible_biases,
+    hidden_biases,
+    n_gibbs,
+    rng,
+    *,
+    hidden_noise=0.0,
+    observed_mask=None,
 ):
-    """Alternating Gibbs sampling of new frames through a stack of CRBMs.
+    """Alternating Gibbs sampling of new frames through a whole stack of CRBMs.
 
     With one layer this is :func:`gibbs_frames`.  With more, each iteration
     passes the frame up the lower layers (hidden probabilities, as the
     layers above were trained on), takes one alternating step of the top
-    layer (its hidden units sampled, its visibles set to their mean), and
-    passes the result down the lower layers as visible means (the
-    generation scheme of the original two-level code, ``gen2.m``).  Where
-    ``observed_mask`` is True the frame stays clamped at ``start``.  The last
-    iteration is mean field.
+    layer (its hidden units sampled, with ``hidden_noise``, by
+    :class:`HiddenSampler`; its visibles set to their mean), and passes the
+    result down the lower layers as visible means, so that the frame itself
+    is the state of the chain and can be clamped: where ``observed_mask`` is
+    True it stays at ``start``.  The last iteration is mean field.
 
     Parameters
     ----------
@@ -713,18 +827,27 @@ def stacked_gibbs_frames(
             hidden_biases[0],
             n_gibbs,
             rng,
+            hidden_noise=hidden_noise,
             observed_mask=observed_mask,
         )
     visible = start.copy()
     clamped = None if observed_mask is None else start[observed_mask]
     top = layers[-1]
+    sample_hidden = HiddenSampler(top, hidden_biases[-1])
+    hidden = np.empty_like(sample_hidden.bias)
+    work = np.empty_like(hidden)
+    noise = np.empty_like(hidden) if hidden_noise else None
     for step in range(n_gibbs + 1):
         state = visible
         for params, hidden_bias in zip(layers[:-1], hidden_biases[:-1], strict=True):
             state = hidden_probabilities(params, state, hidden_bias)
-        hidden = hidden_probabilities(top, state, hidden_biases[-1])
         if step < n_gibbs:
-            hidden = sample_bernoulli(hidden, rng)
+            with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+                sample_hidden(
+                    state, rng, hidden, work, hidden_noise=hidden_noise, noise=noise
+                )
+        else:
+            hidden_probabilities(top, state, hidden_biases[-1], out=hidden)
         state = visible_means(top, hidden, visible_biases[-1])
         below = zip(layers[-2::-1], visible_biases[-2::-1], strict=True)
         for params, visible_bias in below:

@@ -22,27 +22,13 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
 from sklearn_crbm import ConditionalRBM, TrainingDivergedError
-from sklearn_crbm._crbm import _rng_from
 from sklearn_crbm._crbm_math import cd_gradients, hidden_probabilities
+from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.utils._random import rng_from
 from sklearn_crbm.utils._sequences import balanced_batches, frame_history
 
 
 # --------------------------------------------------------------- helpers
-def oscillations(n_sequences=4, n_frames=40, n_features=5, seed=0):
-    """Noisy phase-shifted sinusoids, a stand-in for cyclic motion."""
-    rng = np.random.default_rng(seed)
-    blocks = []
-    for _ in range(n_sequences):
-        t = np.arange(n_frames) * 0.3 + rng.uniform(0, 2 * np.pi)
-        phases = np.arange(n_features) * 0.7
-        blocks.append(
-            np.sin(t[:, None] + phases)
-            + 0.05 * rng.standard_normal((n_frames, n_features))
-        )
-    X = np.concatenate(blocks)
-    return X, np.repeat(np.arange(n_sequences), n_frames)
-
-
 def random_model(
     n_features=3, n_components=4, order=2, hidden_order=None, seed=0, scale=0.5
 ):
@@ -131,7 +117,7 @@ def sample_from_model(model, n_sequences, n_frames, seed):
     [(3, None, 3), (0, None, 0), (1, 3, 3), (2, 0, 2)],
 )
 def test_fitted_attribute_shapes(order, hidden_order, expected_lags):
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(
         7, order=order, hidden_order=hidden_order, n_iter=2, random_state=0
     )
@@ -151,7 +137,7 @@ def test_fitted_attribute_shapes(order, hidden_order, expected_lags):
 
 
 def test_initialisation_follows_original_code():
-    X, ids = oscillations(n_frames=200, n_features=20)
+    X, ids = make_oscillations(n_frames=200, n_features=20, random_state=0)
     model = ConditionalRBM(300, order=3, n_iter=1, learning_rate=1e-12, random_state=0)
     model.fit(X, sequence_ids=ids)
     assert np.std(model.components_) == pytest.approx(0.01, rel=0.05)
@@ -165,7 +151,7 @@ def test_initialisation_follows_original_code():
 @pytest.mark.parametrize("order, hidden_order", [(2, 2), (1, 3), (3, 0)])
 def test_hidden_probabilities_match_equation(order, hidden_order):
     model = random_model(order=order, hidden_order=hidden_order)
-    X, ids = oscillations(n_sequences=2, n_frames=12, n_features=3)
+    X, ids = make_oscillations(n_sequences=2, n_frames=12, n_features=3, random_state=0)
     H = model.transform(X, sequence_ids=ids)
     L = max(order, hidden_order)
     for sid in (0, 1):
@@ -178,7 +164,7 @@ def test_hidden_probabilities_match_equation(order, hidden_order):
 
 def test_first_frames_use_edge_padded_history():
     model = random_model(order=2)
-    X, _ = oscillations(n_sequences=1, n_frames=6, n_features=3)
+    X, _ = make_oscillations(n_sequences=1, n_frames=6, n_features=3, random_state=0)
     H = model.transform(X)
     # frame 1 has one real past frame; the missing x[-1] is replaced by x[0]
     _, b_hat = exact_dynamic_biases(model, np.array([X[0], X[0]]))
@@ -188,7 +174,7 @@ def test_first_frames_use_edge_padded_history():
 def test_visible_mean_and_free_energy_match_exact_density():
     """score_samples is -F(v|hist): log p(v|hist) = -F - log Z(hist), Z by enumeration."""
     model = random_model(n_features=3, n_components=4, order=2)
-    X, _ = oscillations(n_sequences=1, n_frames=10, n_features=3)
+    X, _ = make_oscillations(n_sequences=1, n_frames=10, n_features=3, random_state=0)
     neg_free_energy = model.score_samples(X)
     for t in range(2, len(X)):
         c_hat, b_hat = exact_dynamic_biases(model, X[t - 2 : t][::-1])
@@ -247,13 +233,13 @@ def test_training_on_crbm_data_raises_exact_likelihood():
 
 # ------------------------------------------------------------ CD update
 def test_one_cd1_update_equals_paper_equations():
-    X, ids = oscillations(n_sequences=2, n_frames=15, n_features=4)
+    X, ids = make_oscillations(n_sequences=2, n_frames=15, n_features=4, random_state=0)
     model = ConditionalRBM(5, order=2, batch_size=1000, n_iter=1, random_state=0)
     model.partial_fit(X, sequence_ids=ids)  # epoch 1; the update we check is epoch 2
     before = copy.deepcopy(model)
 
     # replay the random stream the second epoch will use
-    rng = _rng_from(copy.deepcopy(model.random_state_))
+    rng = rng_from(copy.deepcopy(model.random_state_))
     frames = np.concatenate([np.arange(2, 15), np.arange(17, 30)])
     (batch,) = balanced_batches(frames, 1000, rng)
     uniform = rng.random((len(batch), 5))
@@ -299,7 +285,7 @@ def test_one_cd1_update_equals_paper_equations():
 
 
 def test_momentum_starts_after_delay():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(4, order=1, momentum_delay=2, n_iter=1, random_state=0)
     model.partial_fit(X, sequence_ids=ids)
     assert model.n_iter_ == 1
@@ -314,19 +300,19 @@ def test_momentum_starts_after_delay():
 
 def test_cd_k_runs_k_reconstructions():
     model = random_model(order=1)
-    params = model._params()
-    X, _ = oscillations(n_sequences=1, n_frames=30, n_features=3)
+    params = model._parameters
+    X, _ = make_oscillations(n_sequences=1, n_frames=30, n_features=3, random_state=0)
     history = frame_history(X, np.arange(1, 30), 1)
     g1, e1 = cd_gradients(params, X[1:], history, 1, np.random.default_rng(0))
     g5, e5 = cd_gradients(params, X[1:], history, 5, np.random.default_rng(0))
-    assert not np.allclose(g1[0], g5[0])
+    assert not np.allclose(g1.weights, g5.weights)
     assert e5 > e1  # later reconstructions wander further from the data
 
 
 # ------------------------------------------------------------ sequences
 def test_history_never_crosses_sequence_boundary():
     model = random_model(order=2)
-    X, ids = oscillations(n_sequences=3, n_frames=10, n_features=3)
+    X, ids = make_oscillations(n_sequences=3, n_frames=10, n_features=3, random_state=0)
     together = [
         model.transform(X, sequence_ids=ids),
         model.score_samples(X, sequence_ids=ids),
@@ -350,7 +336,7 @@ def test_history_never_crosses_sequence_boundary():
 
 def test_training_skips_frames_without_full_history():
     """Frames of a sequence shorter than the history never reach the model."""
-    X, ids = oscillations(n_sequences=3, n_frames=30, n_features=3)
+    X, ids = make_oscillations(n_sequences=3, n_frames=30, n_features=3, random_state=0)
     short = np.full((3, 3), 1e6)  # would blow training up if used as current frame
     X_all = np.concatenate([X, short])
     ids_all = np.concatenate([ids, [7, 7, 7]])
@@ -363,7 +349,7 @@ def test_training_skips_frames_without_full_history():
 
 def test_score_is_mean_squared_one_step_error_on_valid_frames():
     model = random_model(order=2)
-    X, ids = oscillations(n_sequences=2, n_frames=12, n_features=3)
+    X, ids = make_oscillations(n_sequences=2, n_frames=12, n_features=3, random_state=0)
     predicted = model.predict_next(X, sequence_ids=ids)
     valid = np.concatenate([np.arange(2, 12), np.arange(14, 24)])
     assert model.score(X, sequence_ids=ids) == pytest.approx(
@@ -372,7 +358,7 @@ def test_score_is_mean_squared_one_step_error_on_valid_frames():
 
 
 def test_score_prefers_history_on_held_out_sequences():
-    X, ids = oscillations(n_sequences=6, n_frames=60)
+    X, ids = make_oscillations(n_sequences=6, n_frames=60, n_features=5, random_state=0)
     train, test = ids < 4, ids >= 4
     scores = {
         order: ConditionalRBM(
@@ -387,7 +373,7 @@ def test_score_prefers_history_on_held_out_sequences():
 
 # ----------------------------------------------------------- generation
 def test_sample_shapes_and_seeds():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(8, order=2, n_iter=5, random_state=0).fit(
         X, sequence_ids=ids
     )
@@ -412,7 +398,7 @@ def test_sample_shapes_and_seeds():
 
 def test_sample_follows_the_seed_dynamics():
     """Seeded with a sequence, generation continues it (the AR part alone would too)."""
-    X, ids = oscillations(n_sequences=6, n_frames=80)
+    X, ids = make_oscillations(n_sequences=6, n_frames=80, n_features=5, random_state=0)
     model = ConditionalRBM(30, order=3, n_iter=150, learning_rate=0.01, random_state=0)
     model.fit(X, sequence_ids=ids)
     generated = model.sample(40, history=X[:3], random_state=1)
@@ -421,7 +407,7 @@ def test_sample_follows_the_seed_dynamics():
 
 
 def test_hidden_noise_changes_samples():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(8, order=2, n_iter=5, random_state=0).fit(
         X, sequence_ids=ids
     )
@@ -432,7 +418,7 @@ def test_hidden_noise_changes_samples():
 
 # ------------------------------------------------------- reproducibility
 def test_same_random_state_same_model_transform_and_samples():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     a = ConditionalRBM(8, order=2, n_iter=5, random_state=42).fit(X, sequence_ids=ids)
     b = ConditionalRBM(8, order=2, n_iter=5, random_state=42).fit(X, sequence_ids=ids)
     for name in (
@@ -453,7 +439,7 @@ def test_same_random_state_same_model_transform_and_samples():
 
 
 def test_partial_fit_epochs_equal_fit():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     fitted = ConditionalRBM(6, order=2, n_iter=3, random_state=0).fit(
         X, sequence_ids=ids
     )
@@ -467,7 +453,7 @@ def test_partial_fit_epochs_equal_fit():
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
 def test_dtype_is_preserved_end_to_end(dtype):
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(6, order=2, n_iter=3, random_state=0).fit(
         X.astype(dtype), sequence_ids=ids
     )
@@ -487,7 +473,7 @@ def test_dtype_is_preserved_end_to_end(dtype):
 
 def test_float32_and_float64_learn_alike():
     """The two precisions draw different random bits, so compare what they learn."""
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     a = ConditionalRBM(10, order=2, n_iter=60, learning_rate=0.01, random_state=0).fit(
         X, sequence_ids=ids
     )
@@ -502,7 +488,7 @@ def test_float32_and_float64_learn_alike():
 
 # -------------------------------------------------------------- variants
 def test_order_zero_is_a_plain_rbm():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(6, order=0, n_iter=3, random_state=0).fit(
         X, sequence_ids=ids
     )
@@ -522,7 +508,7 @@ def test_binary_visibles():
     ).fit(X)
     samples = model.sample(5, n_sequences=2)
     assert np.all((samples >= 0) & (samples <= 1))
-    params = model._params()
+    params = model._parameters
     H = hidden_probabilities(
         params, X[1:], params.hidden_bias + X[:-1] @ model.past_to_hidden_[0].T
     )
@@ -532,7 +518,7 @@ def test_binary_visibles():
 
 
 def test_verbose_reports_progress(capsys):
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     ConditionalRBM(4, n_iter=4, verbose=2, random_state=0).fit(X, sequence_ids=ids)
     lines = capsys.readouterr().out.strip().splitlines()
     assert len(lines) == 2
@@ -541,7 +527,7 @@ def test_verbose_reports_progress(capsys):
 
 
 def test_divergence_raises_naming_the_learning_rate():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(
         8, order=2, learning_rate=50.0, momentum_delay=0, n_iter=50, random_state=0
     )
@@ -553,7 +539,7 @@ def test_divergence_raises_naming_the_learning_rate():
 
 
 def test_pipeline_routes_sequence_ids():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     direct = ConditionalRBM(6, order=2, n_iter=3, random_state=0)
     direct.fit(StandardScaler().fit_transform(X), sequence_ids=ids)
     with sklearn.config_context(enable_metadata_routing=True):
@@ -572,7 +558,7 @@ def test_pipeline_routes_sequence_ids():
 
 
 def test_fit_transform_uses_sequence_ids():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(6, order=2, n_iter=3, random_state=0)
     assert_allclose(
         model.fit_transform(X, sequence_ids=ids), model.transform(X, sequence_ids=ids)
@@ -581,7 +567,7 @@ def test_fit_transform_uses_sequence_ids():
 
 # ------------------------------------------------------------ bad input
 def test_bad_input_gets_clear_errors():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(4, order=2, n_iter=1, random_state=0)
     X_nan = X.copy()
     X_nan[3, 1] = np.nan
@@ -611,7 +597,7 @@ def test_bad_input_gets_clear_errors():
 
 
 def test_sample_n_jobs_gives_the_same_frames():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(6, order=2, n_iter=2, random_state=0).fit(
         X, sequence_ids=ids
     )

@@ -31,8 +31,7 @@ def make_params(dtype=np.float64, order=2, hidden_order=2, seed=0, scale=0.5):
     params = CRBMParameters.initialize(
         5, 7, order, hidden_order, "gaussian", dtype, rng
     )
-    for array in params.arrays():
-        array[...] = scale * rng.standard_normal(array.shape)
+    params.flat[...] = scale * rng.standard_normal(params.flat.shape)
     params.dynamic *= params.dynamic_mask()
     return params
 
@@ -148,7 +147,8 @@ def test_cd_gradients_scale_into_reused_buffers(cd_steps, orders):
     plain, error = cd_gradients(
         params, visible, history, cd_steps, np.random.default_rng(0)
     )
-    out = [np.full_like(a, np.nan) for a in params.arrays()]
+    out = params.zeros_like()
+    out.flat[...] = np.nan
     workspace = CDWorkspace(params, 50)  # larger than the batch: reused slices
     result, error2 = cd_gradients(
         params,
@@ -161,52 +161,99 @@ def test_cd_gradients_scale_into_reused_buffers(cd_steps, orders):
         workspace=workspace,
     )
     assert error2 == pytest.approx(error, rel=1e-12)
-    for got, array, gradient in zip(result, out, plain, strict=True):
-        assert got is array
-        assert_allclose(array, 0.01 * gradient, rtol=1e-10, atol=1e-14)
-    assert_array_equal(plain[3] * (1 - params.dynamic_mask()), 0)
+    assert result is out
+    assert_allclose(out.flat, 0.01 * plain.flat, rtol=1e-10, atol=1e-14)
+    assert_array_equal(plain.dynamic * (1 - params.dynamic_mask()), 0)
 
 
 @pytest.mark.parametrize("dtype", [np.float64, np.float32])
 @pytest.mark.parametrize("orders", [(2, 2), (1, 3), (0, 0)])
 def test_momentum_update_is_the_original_update_rule(dtype, orders):
-    params = make_params(dtype, order=orders[0], hidden_order=orders[1])
-    rng = np.random.default_rng(5)
-    velocities = [rng.standard_normal(a.shape).astype(dtype) for a in params.arrays()]
-    velocities[3] *= params.dynamic_mask()
-    before = [a.copy() for a in params.arrays()]
-    old_velocities = [v.copy() for v in velocities]
-    update = MomentumUpdate(params, velocities)
-    # params now view one buffer, in Fortran order, with the same values
-    for array, value in zip(params.arrays(), before, strict=True):
-        assert array.size == 0 or np.shares_memory(array, update.parameters)
-        assert_array_equal(array, value)
+    params = make_params(dtype, order=orders[0], hidden_order=orders[1]).copy("F")
     assert params.weights.flags.f_contiguous and params.dynamic.flags.f_contiguous
-    statistics = [rng.standard_normal(a.shape).astype(dtype) for a in before]
-    statistics[3] *= params.dynamic_mask()
-    for buffer, statistic in zip(update.statistics, statistics, strict=True):
-        buffer[...] = statistic
+    rng = np.random.default_rng(5)
+    velocity = params.zeros_like()
+    velocity.flat[...] = rng.standard_normal(velocity.flat.shape)
+    velocity.dynamic *= params.dynamic_mask()
+    before, old_velocity = params.copy(), velocity.copy()
+    update = MomentumUpdate(params, velocity)
+    statistics = update.statistics
+    statistics.flat[...] = rng.standard_normal(statistics.flat.shape)
+    statistics.dynamic *= params.dynamic_mask()
+    expected_statistics = statistics.copy()
     update.apply(0.9, 0.1, 0.02)
-    decays = (0.02, 0.0, 0.0, 0.02)  # W and the directed weights only
+    decays = {"weights": 0.02, "dynamic": 0.02}  # W and the directed weights only
     tol = dict(rtol=1e-5, atol=1e-6) if dtype == np.float32 else dict(rtol=1e-12)
-    for k, (param, velocity) in enumerate(
-        zip(params.arrays(), update.velocities, strict=True)
-    ):
-        expected = 0.9 * old_velocities[k] + statistics[k] - 0.1 * decays[k] * before[k]
-        assert_allclose(velocity, expected, **tol)
-        assert_allclose(param, before[k] + expected, **tol)
+    for name in ("weights", "hidden_bias", "visible_bias", "dynamic"):
+        expected = (
+            0.9 * getattr(old_velocity, name)
+            + getattr(expected_statistics, name)
+            - 0.1 * decays.get(name, 0.0) * getattr(before, name)
+        )
+        assert_allclose(getattr(update.velocity, name), expected, **tol)
+        assert_allclose(getattr(params, name), getattr(before, name) + expected, **tol)
     assert_array_equal(params.dynamic * (1 - params.dynamic_mask()), 0)
+
+
+def test_parameters_are_views_of_one_buffer_in_either_layout():
+    params = make_params(order=3, hidden_order=1)
+    for layout in ("C", "F"):
+        copy = params.copy(layout)
+        views = [
+            copy.weights,
+            copy.hidden_bias,
+            copy.visible_bias,
+            copy.dynamic,
+            copy.autoregressive,
+            copy.past_to_hidden,
+        ]
+        for view in views:
+            assert np.shares_memory(view, copy.flat)
+        assert copy.weights.flags[f"{layout}_CONTIGUOUS"]
+        assert_array_equal(copy.weights, params.weights)
+        assert_array_equal(copy.dynamic, params.dynamic)
+        # the lag blocks of the public layout, read from the packed matrix
+        n = params.n_features
+        for q in range(3):
+            assert_array_equal(
+                copy.autoregressive[q], params.dynamic[:n, q * n : (q + 1) * n]
+            )
+        assert_array_equal(copy.past_to_hidden[0], params.dynamic[n:, :n])
+    # weight decay covers exactly the directed and symmetric weights
+    decayed = np.zeros(params.flat.shape, bool)
+    decayed[params.decayed] = True
+    for name, expected in [
+        ("weights", True),
+        ("dynamic", True),
+        ("hidden_bias", False),
+    ]:
+        view = params.views(decayed)[name]
+        assert view.all() == expected and view.any() == expected
+
+
+def test_parameters_pickle_as_one_buffer():
+    import pickle
+
+    params = make_params().copy("F")
+    loaded = pickle.loads(pickle.dumps(params))
+    assert_array_equal(loaded.flat, params.flat)
+    assert loaded.layout == "F"
+    loaded.flat[0] += 1  # the views follow the loaded buffer
+    assert loaded.weights.flags.f_contiguous
+    assert np.shares_memory(loaded.weights, loaded.flat)
 
 
 def test_cd_gradients_do_not_depend_on_memory_layout():
     params = make_params()
     visible, history = batch(params)
     c_order, _ = cd_gradients(params, visible, history, 1, np.random.default_rng(0))
-    params.weights = np.asfortranarray(params.weights)
-    params.dynamic = np.asfortranarray(params.dynamic)
-    f_order, _ = cd_gradients(params, visible, history, 1, np.random.default_rng(0))
-    for a, b in zip(c_order, f_order, strict=True):
-        assert_allclose(a, b, rtol=1e-12, atol=1e-14)
+    f_order, _ = cd_gradients(
+        params.copy("F"), visible, history, 1, np.random.default_rng(0)
+    )
+    for name in ("weights", "hidden_bias", "visible_bias", "dynamic"):
+        assert_allclose(
+            getattr(c_order, name), getattr(f_order, name), rtol=1e-12, atol=1e-14
+        )
 
 
 def test_gibbs_frames_keep_observed_values_and_draw_as_before():

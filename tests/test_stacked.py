@@ -1,4 +1,4 @@
-"""Tests of StackedCRBM: greedy training, the passes up and down, generation, checks."""
+"""Tests of StackedCRBM: greedy training, the passes up and down, generation."""
 
 import numpy as np
 import pytest
@@ -8,33 +8,10 @@ from scipy.special import expit
 from sklearn.exceptions import NotFittedError
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
-from sklearn.utils.estimator_checks import (
-    check_param_validation,
-    parametrize_with_checks,
-)
 
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm._stacked import StackedCRBM
-
-ROW_DEPENDENCE = (
-    "rows are frames of sequences: each frame's output depends on the frames "
-    "before it in its sequence, so outputs change when rows are dropped or "
-    "reordered"
-)
-
-
-def oscillations(n_sequences=4, n_frames=40, n_features=5, seed=0):
-    """Noisy phase-shifted sinusoids, a stand-in for cyclic motion."""
-    rng = np.random.default_rng(seed)
-    blocks = []
-    for _ in range(n_sequences):
-        t = np.arange(n_frames) * 0.3 + rng.uniform(0, 2 * np.pi)
-        phases = np.arange(n_features) * 0.7
-        blocks.append(
-            np.sin(t[:, None] + phases)
-            + 0.05 * rng.standard_normal((n_frames, n_features))
-        )
-    return np.concatenate(blocks), np.repeat(np.arange(n_sequences), n_frames)
+from sklearn_crbm.datasets import make_oscillations
 
 
 def small_stack(**params):
@@ -43,32 +20,16 @@ def small_stack(**params):
     return StackedCRBM(**defaults)
 
 
-# ------------------------------------------------------- sklearn's checks
-@parametrize_with_checks(
-    [small_stack(n_components=(8, 6), order=3)],
-    expected_failed_checks=lambda estimator: {
-        "check_methods_subset_invariance": ROW_DEPENDENCE,
-        "check_methods_sample_order_invariance": ROW_DEPENDENCE,
-    },
-)
-def test_sklearn_compatible_estimator(estimator, check):
-    check(estimator)
-
-
-def test_param_validation():
-    check_param_validation("StackedCRBM", small_stack())
-
-
 @pytest.mark.parametrize("bad", [(), (4, 0), (4, 2.5), "abc", (True, 3)])
 def test_bad_layer_sizes_are_rejected(bad):
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     with pytest.raises((ValueError, TypeError), match="n_components"):
         small_stack(n_components=bad).fit(X, sequence_ids=ids)
 
 
 # ---------------------------------------------------------- greedy training
 def test_layers_are_trained_greedily_on_valid_hidden_probabilities():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack(n_components=(6, 4), order=2, hidden_order=3).fit(
         X, sequence_ids=ids
     )
@@ -101,7 +62,7 @@ def test_layers_are_trained_greedily_on_valid_hidden_probabilities():
 
 
 def test_single_int_gives_one_layer_equal_to_conditional_rbm():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack(n_components=5).fit(X, sequence_ids=ids)
     assert len(stack.layers_) == 1
     layer = stack.layers_[0]
@@ -114,7 +75,7 @@ def test_single_int_gives_one_layer_equal_to_conditional_rbm():
 
 
 def test_three_layers_and_history_length():
-    X, ids = oscillations(n_frames=30)
+    X, ids = make_oscillations(n_frames=30, n_features=5, random_state=0)
     stack = small_stack(n_components=(6, 5, 3), order=1, hidden_order=2).fit(
         X, sequence_ids=ids
     )
@@ -125,13 +86,13 @@ def test_three_layers_and_history_length():
 
 
 def test_too_short_sequences_are_an_error_naming_the_length():
-    X, ids = oscillations(n_frames=4)
+    X, ids = make_oscillations(n_frames=4, n_features=5, random_state=0)
     with pytest.raises(ValueError, match="at least 5 frames"):
         small_stack(order=2).fit(X, sequence_ids=ids)
 
 
 def test_partial_fit_trains_every_layer_one_epoch_per_call():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack()
     for _ in range(3):
         assert stack.partial_fit(X, sequence_ids=ids) is stack
@@ -143,7 +104,7 @@ def test_partial_fit_trains_every_layer_one_epoch_per_call():
 
 # ---------------------------------------------------------------- inference
 def test_transform_is_top_layer_on_bottom_probabilities():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack().fit(X, sequence_ids=ids)
     bottom, top = stack.layers_
     expected = top.transform(bottom.transform(X, sequence_ids=ids), sequence_ids=ids)
@@ -152,7 +113,7 @@ def test_transform_is_top_layer_on_bottom_probabilities():
 
 
 def test_predict_next_goes_up_then_down_by_the_equations():
-    X, ids = oscillations(n_sequences=1, n_frames=30)
+    X, ids = make_oscillations(n_sequences=1, n_frames=30, n_features=5, random_state=0)
     stack = small_stack().fit(X)
     bottom, top = stack.layers_
     H = bottom.transform(X)
@@ -178,7 +139,7 @@ def test_predict_next_goes_up_then_down_by_the_equations():
 
 
 def test_score_is_mean_squared_error_on_frames_with_full_stack_history():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack().fit(X, sequence_ids=ids)
     predicted = stack.predict_next(X, sequence_ids=ids)
     valid = np.concatenate([np.flatnonzero(ids == s)[4:] for s in np.unique(ids)])
@@ -194,9 +155,11 @@ def test_score_is_mean_squared_error_on_frames_with_full_stack_history():
 
 
 def test_trained_stack_predicts_better_than_the_mean():
-    X, ids = oscillations(n_sequences=6, n_frames=60)
+    X, ids = make_oscillations(n_sequences=6, n_frames=60, n_features=5, random_state=0)
     stack = small_stack(n_components=(16, 8), n_iter=60).fit(X, sequence_ids=ids)
-    X_test, ids_test = oscillations(n_sequences=2, n_frames=60, seed=1)
+    X_test, ids_test = make_oscillations(
+        n_sequences=2, n_frames=60, n_features=5, random_state=1
+    )
     assert stack.score(X_test, sequence_ids=ids_test) > -0.5 * np.mean(
         np.var(X_test, 0)
     )
@@ -204,7 +167,7 @@ def test_trained_stack_predicts_better_than_the_mean():
 
 # --------------------------------------------------------------- generation
 def test_sample_is_top_down_as_gen2():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack().fit(X, sequence_ids=ids)
     bottom, top = stack.layers_
     seed = X[:4]
@@ -231,7 +194,7 @@ def test_sample_is_top_down_as_gen2():
 
 
 def test_sample_shapes_seeds_and_reproducibility():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack().fit(X.astype(np.float32), sequence_ids=ids)
     assert stack.seed_windows_.shape[1:] == (4, 5)
     default = stack.sample(5, n_sequences=3)
@@ -258,7 +221,7 @@ def test_sample_shapes_seeds_and_reproducibility():
 
 
 def test_generated_oscillation_keeps_moving():
-    X, ids = oscillations(n_sequences=8, n_frames=80, n_features=4)
+    X, ids = make_oscillations(n_sequences=8, n_frames=80, n_features=4, random_state=0)
     stack = StackedCRBM((32, 16), order=2, n_iter=150, random_state=0).fit(
         X, sequence_ids=ids
     )
@@ -270,7 +233,7 @@ def test_generated_oscillation_keeps_moving():
 
 # ------------------------------------------------------------------ routing
 def test_pipeline_routes_sequence_ids():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     with sklearn.config_context(enable_metadata_routing=True):
         pipe = make_pipeline(StandardScaler(), small_stack())
         pipe.fit(X, sequence_ids=ids)
@@ -283,7 +246,7 @@ def test_pipeline_routes_sequence_ids():
 
 
 def test_feature_names_out():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack().fit(X, sequence_ids=ids)
     assert_array_equal(
         stack.get_feature_names_out(), [f"stackedcrbm{i}" for i in range(4)]
@@ -292,7 +255,7 @@ def test_feature_names_out():
 
 # ------------------------------------------------------------ history noise
 def test_history_noise_shrinks_the_directed_weights_and_only_affects_training():
-    X, ids = oscillations(n_sequences=6, n_frames=60)
+    X, ids = make_oscillations(n_sequences=6, n_frames=60, n_features=5, random_state=0)
     params = dict(
         n_components=8, order=2, n_iter=100, learning_rate=1e-2, random_state=0
     )
@@ -313,7 +276,7 @@ def test_history_noise_shrinks_the_directed_weights_and_only_affects_training():
 
 
 def test_stack_passes_history_noise_to_every_layer():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack(history_noise=0.3).fit(X, sequence_ids=ids)
     assert [layer.history_noise for layer in stack.layers_] == [0.3, 0.3]
     per_layer = small_stack(history_noise=[0.5, 0.1]).fit(X, sequence_ids=ids)
@@ -325,7 +288,7 @@ def test_stack_passes_history_noise_to_every_layer():
 
 
 def test_a_failed_fit_leaves_the_stack_unfitted():
-    X, ids = oscillations()
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     stack = small_stack()
     with pytest.raises(ValueError, match="at least 5 frames"):
         stack.fit(X, sequence_ids=np.arange(len(X)) // 3)

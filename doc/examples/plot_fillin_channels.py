@@ -32,6 +32,8 @@ import sklearn
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm.datasets import load_cmu35, make_walker
 from sklearn_crbm.impute import CRBMImputer, NearestNeighborImputer
+from sklearn_crbm.metrics import fillin_error
+from sklearn_crbm.model_selection import erasure_mask
 from sklearn_crbm.plotting import plot_filled_channels
 from sklearn_crbm.preprocessing import make_motion_preprocessor
 
@@ -68,23 +70,20 @@ nearest = NearestNeighborImputer().fit(Z_train)
 # %%
 # Erase the left leg from half-way through and fill it in
 # -------------------------------------------------------
-left_leg = [
-    i
-    for i, n in enumerate(names)
-    if n.split("_")[0] in ("lfemur", "ltibia", "lfoot", "ltoes")
-]
-start = len(Z_test) // 2
-Z_missing = Z_test.copy()
-Z_missing[start:, left_leg] = np.nan
+# :func:`~sklearn_crbm.model_selection.erasure_mask` erases from half-way
+# through by default (the last half of the frames, rounded down, as in the
+# paper); the left leg is the left thigh and every bone below it.
+missing = erasure_mask(
+    Z_test, bones=train.skeleton.descendants("lfemur"), feature_names=names
+)
+start = np.flatnonzero(missing.any(axis=1))[0]
+Z_missing = np.where(missing, np.nan, Z_test)
 Z_model = imputer.transform(Z_missing)
 Z_nearest = nearest.transform(Z_missing)
 
 for label, filled in (("model", Z_model), ("nearest neighbour", Z_nearest)):
-    error = np.square(filled[start:, left_leg] - Z_test[start:, left_leg])
-    print(
-        f"{label}: mean squared error per joint angle, summed over frames: "
-        f"{error.mean(axis=1).sum():.2f}"
-    )
+    error = fillin_error(Z_test, filled, missing_mask=missing)
+    print(f"{label}: the paper's error (MSE per frame, summed) {error:.2f}")
 
 # %%
 # The left hip's three angles, as in Fig. 4

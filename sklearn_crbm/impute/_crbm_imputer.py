@@ -10,47 +10,24 @@ from sklearn.base import (
     _fit_context,
     clone,
 )
-from sklearn.utils import check_random_state
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import HasMethods, Interval, MissingValues
 from sklearn.utils.validation import check_is_fitted
 
+from .._base import check_count
 from .._crbm import ConditionalRBM
-from .._crbm_math import (
-    dynamic_biases,
-    hidden_probabilities,
-    observed_log_likelihood,
-    stacked_gibbs_frames,
-    stacked_prediction,
-)
+from .._online import WHOLE_STACK, Observed, run_online
 from ..utils._fitting import unfitted_on_error
 from ..utils._parallel import map_sequence_blocks
 from ..utils._persistence import VersionedPickleMixin
+from ..utils._random import rng_from
 from ..utils._sequences import Sequences, check_sequence_ids
 from ._base import check_imputer_input, complete_runs
 
-# Rounds of "fill, then use the fill as its own past" for the first frame of a
-# sequence, which has no past frames.
-_FIRST_FRAME_ROUNDS = 3
-# Mean-field iterations of the one-step prediction that weights particles.
-_PREDICTION_STEPS = 10
 # history_noise of the default model: removes the drift of on-line fill-in on
 # CMU 35 (benchmarks/paper_fillin.py, 5 training seeds; 0.4 does too) and keeps
 # generated styles stable (benchmarks/generation_styles.py, where 0.4 does not).
 DEFAULT_HISTORY_NOISE = 0.8
-
-
-def _rng_from(random_state):
-    """A numpy Generator seeded from a scikit-learn ``random_state``."""
-    seed = check_random_state(random_state).randint(np.iinfo(np.int32).max)
-    return np.random.default_rng(seed)
-
-
-def _layers(estimator):
-    """The fitted CRBM layers of a ConditionalRBM or a StackedCRBM, bottom first."""
-    if hasattr(estimator, "layers_"):
-        return list(estimator.layers_)
-    return [estimator]
 
 
 class CRBMImputer(
@@ -158,9 +135,11 @@ class CRBMImputer(
     those that explain the data.  The filter stays on-line: frame ``t``'s
     fill never changes afterwards.
 
-    *Wholly missing frames* are generated from their past alone, as
-    :meth:`ConditionalRBM.sample` does, starting from the previous frame.
-    Frames without missing channels are copied and cost nothing.
+    *Wholly missing frames* are generated from their past alone by the same
+    on-line loop as :meth:`ConditionalRBM.sample`
+    (:func:`~sklearn_crbm._online.run_online`), starting from the previous
+    frame (without ``sample``'s small jitter).  Frames without missing
+    channels are copied and cost nothing.
 
     All sequences advance frame by frame together, and so do the
     ``n_draws * n_particles`` chains: the cost is about ``2 * n_gibbs``
@@ -172,9 +151,14 @@ class CRBMImputer(
     :class:`~sklearn_crbm.StackedCRBM`.  With a stack each Gibbs iteration
     passes the frame up the lower layers (hidden probabilities), takes one
     alternating step of the top layer and passes the result down as visible
-    means (the original two-level generation scheme), with the observed
-    channels clamped; every layer's directed connections see that layer's
-    own on-line past.
+    means, with the observed channels clamped; every layer's directed
+    connections see that layer's own on-line past (the frame's hidden
+    probabilities in the layer below).  This is the ``"whole_stack"``
+    scheme of :func:`~sklearn_crbm._online.run_online`: the clamped
+    channels live at the bottom, so the frame itself must be the chain's
+    state.  :meth:`StackedCRBM.sample`, with nothing to clamp, runs the
+    chain in the top layer alone and passes it down once (``"top_layer"``,
+    the original two-level code's scheme).
 
     References
     ----------
@@ -333,12 +317,9 @@ class CRBMImputer(
         X_filled : ndarray of shape (n_samples, n_frames, n_features)
             The fills; observed values are unchanged in each.
         """
-        if isinstance(n_samples, bool) or not isinstance(n_samples, Integral):
-            raise ValueError(f"n_samples must be an integer >= 1, got {n_samples!r}.")
-        if n_samples < 1:
-            raise ValueError(f"n_samples must be an integer >= 1, got {n_samples!r}.")
+        n_samples = check_count(n_samples, "n_samples", minimum=1)
         random_state = self.random_state if random_state is None else random_state
-        return self._impute(X, sequence_ids, int(n_samples), random_state, False)
+        return self._impute(X, sequence_ids, n_samples, random_state, False)
 
     def _impute(self, X, sequence_ids, n_draws, random_state, average):
         check_is_fitted(self)
@@ -346,9 +327,8 @@ class CRBMImputer(
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
         if not mask.any():
             return X if average else np.broadcast_to(X, (n_draws, *X.shape)).copy()
-        rng = _rng_from(random_state)
-        layers = [layer._params() for layer in _layers(self.estimator_)]
-        draws = self._fill_blocks(layers, X, mask, sequences, n_draws, rng)
+        rng = rng_from(random_state)
+        draws = self._fill_blocks(X, mask, sequences, n_draws, rng)
         if average:
             X[mask] = draws.mean(axis=0)[mask]
             return X
@@ -356,7 +336,7 @@ class CRBMImputer(
         out[:, mask] = draws[:, mask]
         return out
 
-    def _fill_blocks(self, layers, X, mask, sequences, n_draws, rng):
+    def _fill_blocks(self, X, mask, sequences, n_draws, rng):
         """:meth:`_fill` on blocks of whole sequences, in parallel with ``n_jobs``.
 
         The blocks and their random streams depend on the data only
@@ -372,7 +352,7 @@ class CRBMImputer(
                 ids=sequences.ids[block],
             )
             return self._fill(
-                layers, X[lo:hi], mask[lo:hi], block_sequences, n_draws, block_rng
+                X[lo:hi], mask[lo:hi], block_sequences, n_draws, block_rng
             )
 
         blocks = map_sequence_blocks(
@@ -380,204 +360,41 @@ class CRBMImputer(
         )
         return np.concatenate(blocks, axis=1)
 
-    def _fill(self, layers, X, mask, sequences, n_draws, rng):
+    def _fill(self, X, mask, sequences, n_draws, rng):
         """``n_draws`` on-line fills, all sequences and draws advancing together.
 
-        Every draw runs ``n_particles`` chains.  Only the recent past is
-        kept: for every layer, chain and sequence the last ``n_lags`` values
-        of that layer's visible units (``windows``, most recent first; the
-        frames themselves for the bottom layer, the hidden probabilities of
-        the layer below for the others).  A frame's fill is final once the
-        frame is processed.
-
-        Returns an array of shape ``(n_draws, n_frames, n_features)`` in the
-        model's dtype.
+        Every draw runs ``n_particles`` chains (:func:`~sklearn_crbm._online.
+        run_online` with the observed channels clamped); a draw's fill of a
+        frame is the mean of its particles'.  Returns an array of shape
+        ``(n_draws, n_frames, n_features)`` in the model's dtype.
         """
-        n_frames, n_features = X.shape
+        layers = self.estimator_._layer_parameters()
         dtype = layers[0].dtype
-        n_chains = n_draws * self.n_particles
         X = X.astype(dtype)
-        out = np.broadcast_to(X, (n_draws, n_frames, n_features)).copy()
-        mean = self.mean_.astype(dtype)
-        starts, lengths = sequences.starts, sequences.lengths
-        windows = [
-            np.empty(
-                (n_chains, len(starts), max(p.n_lags, 1), p.n_features), dtype=dtype
-            )
-            for p in layers
-        ]
-        for step in range(int(lengths.max(initial=0))):
-            active = np.flatnonzero(lengths > step)
-            rows = starts[active] + step
-            missing = mask[rows]
-            need = np.flatnonzero(missing.any(axis=1))
-            frames = np.where(missing, mean, X[rows])
-            current = np.broadcast_to(frames, (n_chains, *frames.shape)).copy()
-            observed = np.broadcast_to(
-                ~missing[need], (n_chains, len(need), n_features)
-            ).reshape(-1, n_features)
-            if step == 0:
-                # No past: the frame stands in for it (edge padding), and the
-                # fill is repeated with the latest fill as the past.
-                for _ in range(_FIRST_FRAME_ROUNDS if len(need) else 0):
-                    biases = _edge_biases(layers, current[:, need])
-                    current[:, need] = self._fill_frames(
-                        layers, current[:, need], biases, observed, rng
-                    )
-                biases = _edge_biases(layers, current)
-            else:
-                if self.n_particles > 1 and len(need):
-                    self._resample(
-                        layers,
-                        windows,
-                        active[need],
-                        frames[need],
-                        ~missing[need],
-                        n_draws,
-                        rng,
-                    )
-                biases = _window_biases(layers, windows, active)
-                if len(need):
-                    start = np.where(
-                        missing[need], windows[0][:, active[need], 0], frames[need]
-                    )
-                    current[:, need] = self._fill_frames(
-                        layers, start, [b[:, need] for b in biases], observed, rng
-                    )
-            if len(need):
-                fills = current[:, need].reshape(
-                    n_draws, self.n_particles, len(need), -1
-                )
-                out[:, rows[need]] = fills.mean(axis=1)
-            _push(layers, windows, active, current, biases, first=step == 0)
-        return out
-
-    def _fill_frames(self, layers, start, biases, observed, rng):
-        """One clamped Gibbs run for every (chain, frame) pair.
-
-        ``start`` has shape ``(n_chains, n_rows, n_features)``; ``biases``
-        holds every layer's ``(n_chains, n_rows, n_visible + n_hidden)``
-        dynamic biases.
-        """
-        shape = start.shape
-        visible_biases, hidden_biases = _split_biases(layers, biases)
-        frames = stacked_gibbs_frames(
+        out = np.broadcast_to(X, (n_draws, *X.shape)).copy()
+        # a sequence's first frame starts its missing channels at the mean
+        observed = Observed(
+            X=np.where(mask, self.mean_.astype(dtype), X),
+            missing=mask,
+            sequences=sequences,
+        )
+        run = run_online(
             layers,
-            start.reshape(-1, shape[2]),
-            visible_biases,
-            hidden_biases,
-            self.n_gibbs,
             rng,
-            observed_mask=observed,
+            observed=observed,
+            n_chains=n_draws * self.n_particles,
+            n_particles=self.n_particles,
+            n_gibbs=self.n_gibbs,
+            scheme=WHOLE_STACK,
         )
-        return frames.reshape(shape)
-
-    def _resample(self, layers, windows, seqs, frames, observed, n_draws, rng):
-        """Resample each draw's particles by how well they explain the observed data.
-
-        A particle's weight is the likelihood of the frame's observed
-        channels under its own one-step prediction
-        (:func:`~sklearn_crbm._crbm_math.observed_log_likelihood`); each
-        draw's particles are resampled (systematic resampling) and the pasts
-        of the chosen ancestors copied, before the frame is filled.
-        """
-        n_chains = windows[0].shape[0]
-        n_particles = n_chains // n_draws
-        n_features = frames.shape[1]
-        visible_biases, hidden_biases = _split_biases(
-            layers, _window_biases(layers, windows, seqs)
-        )
-        prediction = stacked_prediction(
-            layers, visible_biases, hidden_biases, _PREDICTION_STEPS
-        )
-        log_weights = observed_log_likelihood(
-            layers[0],
-            prediction,
-            np.broadcast_to(frames, (n_chains, *frames.shape)).reshape(-1, n_features),
-            np.broadcast_to(observed, (n_chains, *observed.shape)).reshape(
-                -1, n_features
-            ),
-        ).reshape(n_draws, n_particles, len(seqs))
-        log_weights -= log_weights.max(axis=1, keepdims=True)
-        cumulative = np.cumsum(np.exp(log_weights), axis=1)
-        cumulative /= cumulative[:, -1:]
-        positions = (
-            rng.random((n_draws, 1, len(seqs))) + np.arange(n_particles)[:, None]
-        ) / n_particles
-        # ancestor of particle i: how many cumulative weights lie below position i
-        ancestors = (cumulative[:, None, :, :] < positions[:, :, None, :]).sum(axis=2)
-        np.minimum(ancestors, n_particles - 1, out=ancestors)
-        chains = ancestors + (np.arange(n_draws) * n_particles)[:, None, None]
-        chains = chains.reshape(n_chains, len(seqs))
-        for window in windows:
-            window[:, seqs] = window[chains, seqs[None, :]]
+        for step, active, drawn, frames in run:
+            if not len(drawn):
+                continue
+            fills = frames.reshape(n_draws, self.n_particles, len(drawn), -1)
+            out[:, sequences.starts[active[drawn]] + step] = fills.mean(axis=1)
+        return out
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
         tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
         return tags
-
-
-def _split_biases(layers, biases):
-    """Per-layer ``(..., n_visible + n_hidden)`` biases -> two lists of 2-D arrays."""
-    visible, hidden = [], []
-    for params, both in zip(layers, biases, strict=True):
-        both = both.reshape(-1, both.shape[-1])
-        visible.append(both[:, : params.n_features])
-        hidden.append(both[:, params.n_features :])
-    return visible, hidden
-
-
-def _layer_biases(params, history):
-    """Dynamic biases ``[visible, hidden]`` of ``(n_chains, n_rows, ...)`` histories."""
-    n_chains, n_rows = history.shape[:2]
-    flat = history.reshape(n_chains * n_rows, -1)[
-        :, : params.n_lags * params.n_features
-    ]
-    visible_bias, hidden_bias = dynamic_biases(params, flat)
-    return np.concatenate((visible_bias, hidden_bias), axis=1).reshape(
-        n_chains, n_rows, -1
-    )
-
-
-def _window_biases(layers, windows, seqs):
-    """Every layer's dynamic biases for the next frame of sequences ``seqs``."""
-    return [_layer_biases(p, w[:, seqs]) for p, w in zip(layers, windows, strict=True)]
-
-
-def _representations(layers, frames, biases):
-    """The frame, then every lower layer's hidden probabilities, bottom first."""
-    values = [frames]
-    _, hidden_biases = _split_biases(layers, biases)
-    for params, hidden_bias in zip(layers[:-1], hidden_biases[:-1], strict=True):
-        flat = values[-1].reshape(-1, params.n_features)
-        values.append(
-            hidden_probabilities(params, flat, hidden_bias).reshape(
-                *frames.shape[:2], -1
-            )
-        )
-    return values
-
-
-def _edge_biases(layers, frames):
-    """Biases with each layer's past replaced by the frame's own value (edge pad)."""
-    biases = []
-    values = frames
-    for k, params in enumerate(layers):
-        history = np.tile(values, (1, 1, max(params.n_lags, 1)))
-        biases.append(_layer_biases(params, history))
-        if k + 1 < len(layers):
-            pair = [params, layers[k + 1]]
-            values = _representations(pair, values, biases[-1:] * 2)[1]
-    return biases
-
-
-def _push(layers, windows, seqs, frames, biases, first):
-    """Add a processed frame (and its representations) to the windows of ``seqs``."""
-    values = _representations(layers, frames, biases)
-    for window, value in zip(windows, values, strict=True):
-        if first:
-            window[:, seqs] = value[:, :, None, :]
-        else:
-            window[:, seqs, 1:] = window[:, seqs, :-1]
-            window[:, seqs, 0] = value

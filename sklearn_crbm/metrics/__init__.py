@@ -3,6 +3,7 @@
 from ._fillin import fillin_angle_rmse, fillin_error
 from ._generation import (
     forward_speed,
+    gait_statistics,
     motion_amplitude,
     nearest_style,
     spectral_similarity,
@@ -13,6 +14,7 @@ __all__ = [
     "fillin_angle_rmse",
     "fillin_error",
     "forward_speed",
+    "gait_statistics",
     "motion_amplitude",
     "nearest_style",
     "spectral_similarity",

@@ -1,7 +1,6 @@
 """Scoring imputers by masking channels of held-out sequences."""
 
 from inspect import signature
-from numbers import Integral, Real
 
 import numpy as np
 from sklearn import get_config
@@ -13,7 +12,7 @@ from sklearn.utils.metadata_routing import (
 )
 from sklearn.utils.validation import check_array
 
-from ..utils._sequences import check_sequence_ids
+from ._fillin import check_erasure, erasure_mask
 
 __all__ = ["make_imputation_scorer"]
 
@@ -71,12 +70,15 @@ def make_imputation_scorer(
         (the naming of :mod:`sklearn_crbm.preprocessing` and of raw
         channels).  Added to ``columns``; give at least one of the two.
     start : float or int, default=0.5
-        First erased frame of every sequence: a float in ``[0, 1]`` is a
-        fraction of the sequence's length (``floor(start * length)``), an
-        int a frame index counted from the sequence's first frame.
+        Where the erased part of every sequence begins: a float in
+        ``[0, 1]`` is a position relative to the sequence's length (frame
+        ``i`` of ``n`` is erased when ``start <= i / n``, so the default
+        erases the last ``n // 2`` frames, as the paper does), an int a
+        frame index counted from the sequence's first frame.  See
+        :func:`erasure_mask`, which builds the mask.
     stop : float or int, default=None
-        End (excluded) of the erased frames, in the units of ``start``;
-        ``None`` erases to the end of every sequence.
+        Where it ends (excluded), in the units of ``start``; ``None`` erases
+        to the end of every sequence.
     feature_names : array-like of str, default=None
         Names of the features of ``X``, to resolve ``bones`` and names in
         ``columns``.  ``None`` takes the estimator's ``feature_names_in_``.
@@ -159,20 +161,9 @@ class _ImputationScorer:
     ):
         if not callable(score_func):
             raise TypeError(f"score_func must be callable, got {score_func!r}.")
-        if columns is None and bones is None:
-            raise ValueError(
-                "Give the channels to erase: columns (indices, a boolean mask or "
-                "feature names) and/or bones (bone names)."
-            )
-        _check_position(start, "start")
-        if stop is not None:
-            _check_position(stop, "stop")
-        if isinstance(bones, str):
-            bones = [bones]
+        check_erasure(columns, bones, start, stop)
         if bones is not None:
-            bones = [str(bone) for bone in bones]
-            if not bones:
-                raise ValueError("bones must name at least one bone.")
+            bones = [bones] if isinstance(bones, str) else [str(b) for b in bones]
         self._score_func = score_func
         self._columns = None if columns is None else np.asarray(columns)
         self._bones = bones
@@ -301,44 +292,20 @@ class _ImputationScorer:
         return self._mask(X, sequence_ids, estimator)
 
     def _mask(self, X, sequence_ids, estimator):
-        n_frames, n_features = X.shape
-        sequences = check_sequence_ids(sequence_ids, n_frames)
-        channels = self._channels(n_features, estimator)
-        frames = np.zeros(n_frames, dtype=bool)
-        for first, length in zip(sequences.starts, sequences.lengths, strict=True):
-            lo = _position(self._start, length)
-            hi = length if self._stop is None else _position(self._stop, length)
-            frames[first + lo : first + max(lo, hi)] = True
-        mask = np.outer(frames, channels)
-        if not mask.any():
-            raise ValueError(
-                f"The pattern erases nothing in X of shape {X.shape}: no sequence "
-                f"has frames from start={self._start!r} to stop={self._stop!r}."
-            )
-        return mask
-
-    def _channels(self, n_features, estimator):
-        """Boolean mask over the features: the columns and bones to erase."""
-        channels = np.zeros(n_features, dtype=bool)
         names = None
-        needs_names = self._bones is not None or (
+        if self._bones is not None or (
             self._columns is not None and self._columns.dtype.kind in "OUS"
+        ):
+            names = self._names(X.shape[1], estimator)
+        return erasure_mask(
+            X,
+            columns=self._columns,
+            bones=self._bones,
+            feature_names=names,
+            sequence_ids=sequence_ids,
+            start=self._start,
+            stop=self._stop,
         )
-        if needs_names:
-            names = self._names(n_features, estimator)
-        if self._columns is not None:
-            channels |= _column_mask(self._columns, n_features, names)
-        if self._bones is not None:
-            bone_of = np.array([str(name).rsplit("_", 1)[0] for name in names])
-            for bone in self._bones:
-                found = bone_of == bone
-                if not found.any():
-                    raise ValueError(
-                        f"No feature belongs to bone {bone!r}: features are named "
-                        f"'{{bone}}_{{channel}}', got {list(names[:6])}..."
-                    )
-                channels |= found
-        return channels
 
     def _names(self, n_features, estimator):
         names = self._feature_names
@@ -358,55 +325,6 @@ class _ImputationScorer:
                 "features."
             )
         return names
-
-
-def _check_position(value, name):
-    if isinstance(value, bool) or not isinstance(value, Real):
-        raise TypeError(f"{name} must be a float in [0, 1] or an int, got {value!r}.")
-    if isinstance(value, Integral):
-        if value < 0:
-            raise ValueError(f"{name} must be a frame index >= 0, got {value}.")
-    elif not 0 <= value <= 1:
-        raise ValueError(f"{name} as a fraction must be in [0, 1], got {value}.")
-
-
-def _position(value, length):
-    """Frame index within a sequence of ``length`` frames."""
-    if isinstance(value, Integral):
-        return min(int(value), int(length))
-    return int(np.floor(value * length))
-
-
-def _column_mask(columns, n_features, names):
-    if columns.ndim != 1:
-        raise ValueError(f"columns must be 1-D, got shape {columns.shape}.")
-    if columns.dtype == bool:
-        if len(columns) != n_features:
-            raise ValueError(
-                f"A boolean columns mask needs {n_features} entries, got "
-                f"{len(columns)}."
-            )
-        return columns.copy()
-    mask = np.zeros(n_features, dtype=bool)
-    if columns.dtype.kind in "OUS":
-        index = {str(name): i for i, name in enumerate(names)}
-        unknown = [str(c) for c in columns if str(c) not in index]
-        if unknown:
-            raise ValueError(f"Unknown feature names in columns: {unknown}.")
-        mask[[index[str(c)] for c in columns]] = True
-        return mask
-    if columns.dtype.kind not in "iu":
-        raise TypeError(
-            "columns must hold integer indices, booleans or feature names, got "
-            f"dtype {columns.dtype}."
-        )
-    if len(columns) and (columns.min() < -n_features or columns.max() >= n_features):
-        raise ValueError(
-            f"columns holds indices out of range for {n_features} features: "
-            f"{columns.tolist()}."
-        )
-    mask[columns] = True
-    return mask
 
 
 def _routing_enabled():

@@ -1,4 +1,4 @@
-"""Utilities shared by the estimators: sequence bookkeeping."""
+"""Utilities: sequence bookkeeping, and windows of real frames to seed generation."""
 
 from ._sequences import (
     Sequences,
@@ -8,6 +8,7 @@ from ._sequences import (
     history_indices,
     shuffled_batches,
 )
+from ._windows import random_windows
 
 __all__ = [
     "Sequences",
@@ -15,5 +16,6 @@ __all__ = [
     "check_sequence_ids",
     "frame_history",
     "history_indices",
+    "random_windows",
     "shuffled_batches",
 ]

@@ -6,6 +6,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from sklearn_crbm.metrics import (
     forward_speed,
+    gait_statistics,
     motion_amplitude,
     nearest_style,
     spectral_similarity,
@@ -139,3 +140,31 @@ def test_bad_feature_selection_is_an_error():
         step_frequency(X, frame_rate=0)
     with pytest.raises(ValueError, match="exactly one"):
         forward_speed(X, feature=[0, 1])
+
+
+def test_gait_statistics_are_speed_and_leg_frequency_and_classify_styles():
+    X = np.vstack([gait(30, speed=0.7), gait(21, speed=2.0), gait(28, speed=0.8)])
+    ids = np.repeat([0, 1, 2], 150)
+    stats = gait_statistics(
+        X, sequence_ids=ids, feature_names=NAMES, legs=["lfemur", "rfemur", "ltibia"]
+    )
+    assert stats.shape == (3, 2)
+    assert_array_equal(stats[:, 0], forward_speed(X, sequence_ids=ids, feature=0))
+    assert_array_equal(
+        stats[:, 1], step_frequency(X, sequence_ids=ids, features=[1, 2, 3])
+    )
+    assert_array_equal(
+        nearest_style(stats[2:], stats[:2], ["walk", "jog"]), np.array(["walk"])
+    )
+
+
+def test_gait_statistics_name_the_missing_bone_and_need_names():
+    X = gait(30)
+    with pytest.raises(ValueError, match="No column belongs to bone 'rtibia'"):
+        gait_statistics(X, feature_names=NAMES)  # the CMU default legs
+    with pytest.raises(ValueError, match="feature_names"):
+        gait_statistics(X, legs=["lfemur"])
+    with pytest.raises(ValueError, match="No feature is named 'pelvis_dforward'"):
+        gait_statistics(
+            X, feature_names=NAMES, legs=["lfemur"], speed_feature="pelvis_dforward"
+        )

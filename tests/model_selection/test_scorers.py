@@ -211,7 +211,7 @@ def test_invalid_construction(kwargs, error, match):
         ({"columns": [True, False]}, "boolean columns mask needs 4"),
         ({"columns": ["x"]}, "needs feature names"),
         ({"columns": ["x"], "feature_names": list("abcd")}, "Unknown feature"),
-        ({"bones": "head", "feature_names": list("abcd")}, "No feature belongs"),
+        ({"bones": "head", "feature_names": list("abcd")}, "No column belongs"),
         ({"bones": "head", "feature_names": ["a_x"]}, "1 feature names"),
         ({"columns": [0], "start": 30}, "erases nothing"),
     ],

@@ -3,13 +3,8 @@
 import numpy as np
 import pytest
 import sklearn.preprocessing
-from sklearn.utils.estimator_checks import check_param_validation
 
-from sklearn_crbm.preprocessing import (
-    ExpMapEncoder,
-    RootRelativeEncoder,
-    StandardScaler,
-)
+from sklearn_crbm.preprocessing import StandardScaler
 
 
 @pytest.fixture
@@ -113,10 +108,3 @@ def test_inverse_with_wrong_width_raises(data):
         scaler.inverse_transform(data)
     with pytest.raises(ValueError, match="X has 5 features"):
         scaler.transform(data[:, :5])
-
-
-@pytest.mark.parametrize(
-    "estimator", [ExpMapEncoder(), RootRelativeEncoder(), StandardScaler()]
-)
-def test_param_validation(estimator):
-    check_param_validation(type(estimator).__name__, estimator)

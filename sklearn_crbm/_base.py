@@ -1,0 +1,518 @@
+"""What ConditionalRBM and StackedCRBM share: inference, scoring, generation."""
+
+from abc import ABCMeta, abstractmethod
+from numbers import Integral, Real
+
+import numpy as np
+from sklearn.base import (
+    BaseEstimator,
+    ClassNamePrefixFeaturesOutMixin,
+    TransformerMixin,
+)
+from sklearn.utils._param_validation import Interval, StrOptions
+from sklearn.utils.validation import (
+    _check_sample_weight,
+    check_is_fitted,
+    validate_data,
+)
+
+from ._crbm_math import (
+    sequence_dynamic_biases,
+    sequence_hidden_probabilities,
+    stacked_prediction,
+)
+from ._online import History, run_online
+from .utils._parallel import map_sequence_blocks
+from .utils._persistence import VersionedPickleMixin
+from .utils._random import rng_from
+from .utils._sequences import check_sequence_ids
+
+__all__ = ["BaseCRBM", "check_count", "seed_frames"]
+
+# How many windows of training frames ``fit`` keeps to seed ``sample``.
+MAX_SEED_WINDOWS = 500
+# Mean-field iterations of the one-step-ahead prediction behind ``score``.
+SCORE_MEAN_FIELD_STEPS = 10
+# Sequences generated together in one vectorised pass by ``sample``: one
+# frame of 100 sequences costs little more than one of 1, so blocks are large.
+SAMPLE_BLOCK = 256
+# Standard deviation of the jitter added to the previous frame to start the
+# Gibbs chain of a new frame (REFERENCE.md, gen.m).
+START_JITTER = 0.01
+
+
+class BaseCRBM(
+    VersionedPickleMixin,
+    ClassNamePrefixFeaturesOutMixin,
+    TransformerMixin,
+    BaseEstimator,
+    metaclass=ABCMeta,
+):
+    """Base class of the conditional RBMs: one layer or a stack of them.
+
+    A fitted model is a stack of CRBM layers, bottom first (one for
+    :class:`ConditionalRBM`); the visible units of layer ``k + 1`` are the
+    hidden units of layer ``k``.  This class holds everything that is the
+    same for any such stack: input checks, :meth:`transform`,
+    :meth:`predict_next`, :meth:`score`, :meth:`sample` with its seed
+    windows, and the constants.  Subclasses fit, and provide the hooks
+    :attr:`history_length`, ``_layer_parameters`` (the packed parameters of
+    every layer) and, for generation, ``_generation_scheme`` and
+    ``_chain_rng``.
+    """
+
+    _parameter_constraints: dict = {
+        "order": [Interval(Integral, 0, None, closed="left")],
+        "hidden_order": [None, Interval(Integral, 0, None, closed="left")],
+        "learning_rate": [Interval(Real, 0, None, closed="neither")],
+        "momentum": [Interval(Real, 0, 1, closed="left")],
+        "momentum_delay": [Interval(Integral, 0, None, closed="left")],
+        "weight_decay": [Interval(Real, 0, None, closed="left")],
+        "cd_steps": [Interval(Integral, 1, None, closed="left")],
+        "batch_size": [Interval(Integral, 1, None, closed="left")],
+        "batching": [StrOptions({"balanced", "shuffled"})],
+        "history_noise": [Interval(Real, 0, None, closed="left")],
+        "n_iter": [Interval(Integral, 1, None, closed="left")],
+        "random_state": ["random_state"],
+        "verbose": ["verbose"],
+    }
+
+    # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
+    # search passes ``sequence_ids`` to these methods without being asked.
+    __metadata_request__fit = {"sequence_ids": True}
+    __metadata_request__partial_fit = {"sequence_ids": True}
+    __metadata_request__transform = {"sequence_ids": True}
+    __metadata_request__score = {"sequence_ids": True}
+
+    # ---------------------------------------------------------------- hooks
+
+    @property
+    @abstractmethod
+    def history_length(self):
+        """Past frames a frame's top-layer representation depends on."""
+
+    @abstractmethod
+    def _layer_parameters(self):
+        """The fitted :class:`~sklearn_crbm._crbm_math.CRBMParameters`, bottom first."""
+
+    # How a stack draws a new frame in ``sample`` (see sklearn_crbm._online).
+    _generation_scheme = "top_layer"
+
+    def _chain_rng(self, rng):
+        """The generator of ``sample``'s chains, given the one that picked seeds."""
+        return rng
+
+    @property
+    def _hidden_order(self):
+        return self.order if self.hidden_order is None else self.hidden_order
+
+    @property
+    def _n_lags(self):
+        """Past frames of one layer: ``max(order, hidden_order)``."""
+        return max(self.order, self._hidden_order)
+
+    # ------------------------------------------------------------------ fit
+
+    def fit_transform(self, X, y=None, *, sequence_ids=None):
+        """Fit, then return the top layer's hidden probabilities of ``X``.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            All sequences stacked, each contiguous and in time order.
+        y : None
+            Ignored.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        H : ndarray of shape (n_frames, n_components_out)
+            Hidden probabilities, as :meth:`transform` gives them.
+        """
+        return self.fit(X, sequence_ids=sequence_ids).transform(
+            X, sequence_ids=sequence_ids
+        )
+
+    def _pick_seed_windows(self, X, sequences):
+        """Up to ``MAX_SEED_WINDOWS`` evenly spaced windows of real frames.
+
+        Deterministic (no random draws), so that seeding ``sample`` does not
+        disturb the training random stream.
+        """
+        width = max(self.history_length, 1)
+        ends = evenly_spaced(sequences.valid_frames(width - 1) + 1, MAX_SEED_WINDOWS)
+        rows = ends[:, None] - np.arange(width, 0, -1)
+        return X[rows].astype(self._layer_parameters()[0].dtype, copy=True)
+
+    def _merge_seed_windows(self, new):
+        """Seed windows of a ``partial_fit`` call joined to the earlier ones."""
+        if not hasattr(self, "seed_windows_"):
+            return new
+        windows = np.concatenate((self.seed_windows_, new))
+        return windows[evenly_spaced(np.arange(len(windows)), MAX_SEED_WINDOWS)]
+
+    # ------------------------------------------------------------ inference
+
+    def _check_inference_input(self, X, sequence_ids):
+        check_is_fitted(self)
+        X = validate_data(self, X, dtype=[np.float64, np.float32], reset=False)
+        X = X.astype(self._layer_parameters()[0].dtype, copy=False)
+        return X, check_sequence_ids(sequence_ids, X.shape[0])
+
+    def _representations(self, X, sequences, layers):
+        """The data, then ``layers``' hidden probabilities of it, bottom first."""
+        representations = [X]
+        for params in layers:
+            representations.append(
+                sequence_hidden_probabilities(params, representations[-1], sequences)
+            )
+        return representations
+
+    def transform(self, X, *, sequence_ids=None):
+        """Hidden probabilities of the top layer, frame by frame.
+
+        Each layer's hidden probabilities ``p(h = 1 | x_t, history)`` are the
+        next layer's visible data (a :class:`ConditionalRBM` has one layer).
+        Inside a layer, the first ``max(order, hidden_order)`` frames of each
+        sequence have their missing past frames replaced by the sequence's
+        first frame (edge padding), so every frame gets a row; a frame's
+        output is exact (as during training) once it has
+        :attr:`history_length` past frames in its sequence.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            All sequences stacked, each contiguous and in time order.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        H : ndarray of shape (n_frames, n_components_out)
+            Hidden probabilities of the top layer, in the dtype of the model.
+        """
+        X, sequences = self._check_inference_input(X, sequence_ids)
+        return self._representations(X, sequences, self._layer_parameters())[-1]
+
+    def predict_next(self, X, *, sequence_ids=None):
+        """One-step-ahead prediction of every frame from its history alone.
+
+        A deterministic estimate of ``E[x_t | history]``: the top layer
+        starts from its autoregressive mean and alternates hidden
+        probabilities and visible means ten times (mean field); each layer
+        below turns the predicted probabilities of its hidden units into its
+        visible mean given its own history, down to the data.  The
+        histories of the upper layers are the representations of the past
+        frames (hidden probabilities).  Frame ``t`` itself is not used.
+        Frames with fewer than :attr:`history_length` past frames in their
+        sequence use edge padding, as :meth:`transform` does.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            All sequences stacked, each contiguous and in time order.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        X_pred : ndarray of shape (n_frames, n_features)
+            Predicted frames.
+        """
+        X, sequences = self._check_inference_input(X, sequence_ids)
+        return self._predict_frames(X, sequences)
+
+    def _predict_frames(self, X, sequences, frames=None):
+        layers = self._layer_parameters()
+        representations = self._representations(X, sequences, layers[:-1])
+        frames = np.arange(X.shape[0]) if frames is None else frames
+        predicted = np.empty((len(frames), X.shape[1]), dtype=X.dtype)
+        chunks = zip(
+            *(
+                sequence_dynamic_biases(params, values, sequences, frames)
+                for params, values in zip(layers, representations, strict=True)
+            ),
+            strict=True,
+        )
+        position = 0
+        for per_layer in chunks:
+            rows = per_layer[0][0]
+            predicted[position : position + len(rows)] = stacked_prediction(
+                layers,
+                [visible_bias for _, visible_bias, _ in per_layer],
+                [hidden_bias for _, _, hidden_bias in per_layer],
+                SCORE_MEAN_FIELD_STEPS,
+            )
+            position += len(rows)
+        return predicted
+
+    def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
+        """Negative one-step-ahead prediction error; higher is better.
+
+        The mean, over every frame with :attr:`history_length` past frames
+        in its own sequence and over features, of the squared difference
+        between the frame and :meth:`predict_next`'s prediction from its
+        history.  It is measured in the units of ``X`` (standardised data:
+        fractions of a standard deviation), so models with any
+        ``n_components``, ``order`` or ``hidden_order``, one layer or a stack,
+        can be compared on held-out sequences, e.g. by
+        ``GridSearchCV(scoring=None)`` (give them the same frames, e.g. by
+        scoring on sequences longer than every ``history_length``).  A model
+        without history (``order=0``) predicts the same frame everywhere and
+        scores like a constant prediction.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            All sequences stacked, each contiguous and in time order.
+        y : None
+            Ignored.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+        sample_weight : array-like of shape (n_frames,), default=None
+            Weight of each frame in the mean; frames without a full history
+            are left out whatever their weight.
+
+        Returns
+        -------
+        score : float
+            Negative mean squared one-step-ahead prediction error.
+        """
+        X, sequences = self._check_inference_input(X, sequence_ids)
+        frames = sequences.valid_frames(self.history_length)
+        if len(frames) == 0:
+            raise ValueError(
+                f"score needs frames with {self.history_length} past frames in "
+                "their own sequence; every sequence given is shorter. Pass longer "
+                "sequences."
+            )
+        weights = None
+        if sample_weight is not None:
+            weights = _check_sample_weight(sample_weight, X)[frames]
+        predicted = self._predict_frames(X, sequences, frames)
+        errors = np.mean(np.square(X[frames] - predicted), axis=1)
+        return -float(np.average(errors, weights=weights))
+
+    # ----------------------------------------------------------- generation
+
+    def sample(
+        self,
+        n_samples,
+        *,
+        history=None,
+        n_sequences=1,
+        n_gibbs=30,
+        hidden_noise=0.0,
+        sample_visibles=False,
+        random_state=None,
+        n_jobs=None,
+    ):
+        """Generate new frames by alternating Gibbs sampling (paper §4).
+
+        Each new frame starts from the previous frame plus N(0, 0.01^2)
+        jitter; ``n_gibbs`` alternating Gibbs iterations follow (hidden units
+        sampled, visibles set to their mean), then one mean-field step with
+        hidden probabilities.  All sequences are generated together.  A
+        stack does this in its top layer, whose visible units are the hidden
+        probabilities of the layer below, and each layer below turns them
+        into its visible means given its own generated past, down to the
+        data (Taylor's ``gen2.m``).
+
+        Parameters
+        ----------
+        n_samples : int
+            Number of new frames per sequence.
+        history : array-like, default=None
+            Seed frames, oldest first; at least ``max(history_length, 1)``
+            frames, of which the last that many are used (a stack passes
+            them up its layers).  Shape ``(n_frames, n_features)`` seeds every
+            sequence alike; shape ``(n_sequences, n_frames, n_features)``
+            gives each sequence its own seed.  ``None`` draws windows of real
+            training frames kept by :meth:`fit` (``seed_windows_``).
+        n_sequences : int, default=1
+            Number of sequences to generate; with a 3-D ``history`` it is
+            taken from the history.
+        n_gibbs : int, default=30
+            Alternating Gibbs iterations per frame.
+        hidden_noise : float, default=0.0
+            Standard deviation of Gaussian noise added to the (top layer's)
+            hidden biases each time hidden states are chosen (paper §4.3:
+            transitions between styles).
+        sample_visibles : bool, default=False
+            If True, the (top layer's) visibles are drawn from ``p(v | h,
+            history)`` at every Gibbs step (Gaussian noise of unit variance,
+            or binary states) and each new frame is the last draw: an exact
+            Gibbs sampler whose frames follow ``p(x_t | history)`` when
+            ``n_gibbs`` is large.  The default keeps the original code's
+            scheme (visible means, then a mean-field step), which gives
+            smoother motion.
+        random_state : int, RandomState instance or None, default=None
+            Seeds the generation; ``None`` uses the estimator's
+            ``random_state``, so repeated calls give the same frames when
+            that is an int.
+        n_jobs : int, default=None
+            Number of jobs generating blocks of 256 sequences in parallel
+            (joblib; ``None`` means 1 unless in a
+            :obj:`joblib.parallel_backend` context).  Up to 256 sequences are
+            generated together in one vectorised pass; the blocks and their
+            random streams depend on ``n_sequences`` only, so the frames are
+            the same for any ``n_jobs``.
+
+        Returns
+        -------
+        X_new : ndarray of shape (n_sequences * n_samples, n_features)
+            The generated frames only (not the seed), in long format:
+            rows ``k * n_samples`` to ``(k + 1) * n_samples - 1`` are
+            sequence ``k``.
+        """
+        check_is_fitted(self)
+        n_samples = check_count(n_samples, "n_samples", minimum=1)
+        n_gibbs = check_count(n_gibbs, "n_gibbs", minimum=0)
+        n_sequences = check_count(n_sequences, "n_sequences", minimum=1)
+        if not isinstance(hidden_noise, Real) or not hidden_noise >= 0:
+            raise ValueError(
+                f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
+            )
+        layers = self._layer_parameters()
+        rng = rng_from(self.random_state if random_state is None else random_state)
+        seed = seed_frames(
+            history,
+            n_sequences,
+            width=max(self.history_length, 1),
+            n_features=self.n_features_in_,
+            dtype=layers[0].dtype,
+            seed_windows=self.seed_windows_,
+            rng=rng,
+        )
+        past = History.from_frames(layers, seed[None])
+
+        def generate_block(block, block_rng):
+            frames = np.empty((len(block), n_samples, seed.shape[2]), seed.dtype)
+            run = run_online(
+                layers,
+                block_rng,
+                history=past.select(block),
+                n_steps=n_samples,
+                n_gibbs=n_gibbs,
+                scheme=self._generation_scheme,
+                start_jitter=START_JITTER,
+                hidden_noise=hidden_noise,
+                sample_visibles=sample_visibles,
+            )
+            for step, _, _, new in run:
+                frames[:, step] = new[0]
+            return frames
+
+        blocks = map_sequence_blocks(
+            generate_block,
+            len(seed),
+            self._chain_rng(rng),
+            n_jobs,
+            block_size=SAMPLE_BLOCK,
+        )
+        return np.concatenate(blocks).reshape(-1, self.n_features_in_)
+
+    # ---------------------------------------------------------------- misc
+
+    @property
+    def _n_features_out(self):
+        return self._layer_parameters()[-1].n_components
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.transformer_tags.preserves_dtype = ["float64", "float32"]
+        return tags
+
+
+class FittedParameter:
+    """A fitted attribute that views a group of the packed parameters.
+
+    ``components_ = FittedParameter("weights")`` on the class makes
+    ``model.components_`` the ``weights`` view of ``model._parameters``
+    (:class:`~sklearn_crbm._crbm_math.CRBMParameters`); an unfitted model
+    has no such attribute.  Assigning to it writes into the view (same
+    shape only), so the model computes with what was assigned.
+    """
+
+    def __init__(self, group):
+        self.group = group
+
+    def __set_name__(self, owner, name):
+        self.name = name
+
+    def __get__(self, instance, owner=None):
+        if instance is None:
+            return self
+        try:
+            params = vars(instance)["_parameters"]
+        except KeyError:
+            raise AttributeError(
+                f"{type(instance).__name__!r} object has no attribute {self.name!r}"
+            ) from None
+        return getattr(params, self.group)
+
+    def __set__(self, instance, value):
+        view = self.__get__(instance)
+        value = np.asarray(value)
+        if value.shape != view.shape:
+            raise ValueError(
+                f"{self.name} has shape {view.shape}; got an array of shape "
+                f"{value.shape}. Set the size parameters and refit to change it."
+            )
+        view[...] = value
+
+
+def seed_frames(history, n_sequences, *, width, n_features, dtype, seed_windows, rng):
+    """Check a ``sample`` history; seeds of shape (n_sequences, width, n_features).
+
+    ``None`` draws windows of real training frames from ``seed_windows``; a
+    2-D history seeds every sequence with its last ``width`` rows; a 3-D one
+    gives one seed per sequence.  Oldest frame first.
+    """
+    if history is None:
+        picks = rng.integers(len(seed_windows), size=n_sequences)
+        return seed_windows[picks]
+    if hasattr(history, "toarray") or hasattr(history, "tocsr"):
+        raise TypeError("history must be a dense array, got a sparse matrix.")
+    try:
+        history = np.asarray(history, dtype=dtype)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(
+            f"history must be an array of numbers, got {type(history).__name__}."
+        ) from exc
+    if history.ndim == 2:
+        history = np.broadcast_to(history, (n_sequences, *history.shape))
+    elif history.ndim == 3:
+        if n_sequences not in (1, history.shape[0]):
+            raise ValueError(
+                f"history holds {history.shape[0]} seeds but n_sequences="
+                f"{n_sequences}; give one seed per sequence or a 2-D history."
+            )
+    else:
+        raise ValueError(
+            "history must have shape (n_frames, n_features) or (n_sequences, "
+            f"n_frames, n_features), got shape {history.shape}."
+        )
+    if history.shape[2] != n_features or history.shape[1] < width:
+        raise ValueError(
+            f"history must hold at least {width} frames of {n_features} features "
+            f"each, got shape {history.shape}."
+        )
+    if not np.isfinite(history).all():
+        raise ValueError("history contains NaN or infinity.")
+    return np.ascontiguousarray(history[:, -width:])
+
+
+def evenly_spaced(values, at_most):
+    """At most ``at_most`` entries of ``values``, evenly spaced, first and last kept."""
+    if len(values) <= at_most:
+        return values
+    return values[np.linspace(0, len(values) - 1, at_most).round().astype(np.intp)]
+
+
+def check_count(value, name, minimum):
+    """``value`` as an int; a ValueError naming ``name`` unless it is one >= minimum."""
+    if isinstance(value, bool) or not isinstance(value, Integral) or value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}.")
+    return int(value)

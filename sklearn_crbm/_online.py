@@ -1,0 +1,406 @@
+"""Advancing sequences frame by frame from their own past: generation and fill-in.
+
+:meth:`ConditionalRBM.sample`, :meth:`StackedCRBM.sample` and
+:class:`~sklearn_crbm.impute.CRBMImputer` all call :func:`run_online`, with
+one layer or a stack:
+
+- generation: nothing observed, every frame of every sequence drawn from a
+  seed history;
+- fill-in: the observed channels of every frame clamped, several chains per
+  sequence (``n_draws * n_particles``), particles resampled before every
+  frame, and a sequence's first frame filled from itself as its own past.
+
+:class:`History` keeps the recent past of every chain at every layer and
+gives the dynamic biases of the next frame.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._crbm_math import (
+    dynamic_biases,
+    gibbs_frames,
+    hidden_probabilities,
+    observed_log_likelihood,
+    sequence_hidden_probabilities,
+    stacked_gibbs_frames,
+    stacked_prediction,
+    visible_means,
+)
+from .utils._sequences import Sequences
+
+# How a stack draws a frame (``scheme`` of run_online).  With one layer the two
+# are the same alternating Gibbs run of that layer.
+TOP_LAYER = "top_layer"
+"""The original two-level generation (Taylor's ``gen2.m``): Gibbs sampling in
+the top layer given its own past, then one deterministic pass down (each
+layer's visible means given its own past).  Every layer's past is the values
+that pass produced.  Nothing can be clamped: the data sit at the bottom."""
+WHOLE_STACK = "whole_stack"
+"""Every Gibbs iteration goes up the stack and down again
+(:func:`~sklearn_crbm._crbm_math.stacked_gibbs_frames`), so the state of the
+chain is the frame itself and its observed channels can be clamped.  The
+upper layers' past is the final frame passed up (hidden probabilities)."""
+
+# Rounds of "fill, then use the fill as its own past" for the first frame of a
+# sequence in fill-in, which has no past frames.
+FIRST_FRAME_ROUNDS = 3
+# Mean-field iterations of the one-step prediction that weights particles.
+PREDICTION_STEPS = 10
+
+
+class History:
+    """The recent past of chains of sequences at every layer of a model.
+
+    Parameters
+    ----------
+    layers : list of CRBMParameters
+        Bottom first.
+    windows : list of ndarray
+        One per layer, of shape ``(n_chains, n_sequences, n_slots,
+        n_visible)`` with ``n_slots = max(n_lags, 1)``: the layer's last
+        visible values, most recent first (the frames for the bottom layer,
+        the layer below's hidden probabilities above it).
+    """
+
+    def __init__(self, layers, windows):
+        self.layers = layers
+        self.windows = windows
+
+    @classmethod
+    def from_frames(cls, layers, frames):
+        """The past made of ``frames``, passed up the layers with edge padding.
+
+        Parameters
+        ----------
+        frames : ndarray of shape (n_chains, n_sequences, n_frames, n_features)
+            Oldest first.  Layer ``k + 1`` sees layer ``k``'s hidden
+            probabilities of these frames, each given its past inside
+            ``frames`` (the first frame repeated where that runs out, as
+            :meth:`ConditionalRBM.transform` does), and keeps those with a
+            full past at layer ``k`` (at least the last one).  A window
+            longer than what a layer keeps repeats the oldest kept value.
+        """
+        n_chains, n_sequences = frames.shape[:2]
+        windows = []
+        values = frames
+        for k, params in enumerate(layers):
+            n_frames = values.shape[2]
+            n_slots = max(params.n_lags, 1)
+            picks = np.maximum(np.arange(n_frames - 1, n_frames - 1 - n_slots, -1), 0)
+            windows.append(np.ascontiguousarray(values[:, :, picks]))
+            if k + 1 < len(layers):
+                flat = values.reshape(-1, values.shape[3])
+                lengths = np.full(n_chains * n_sequences, n_frames, dtype=np.intp)
+                sequences = Sequences(
+                    starts=np.arange(0, len(flat), n_frames, dtype=np.intp),
+                    lengths=lengths,
+                    ids=np.arange(len(lengths)),
+                )
+                hidden = sequence_hidden_probabilities(params, flat, sequences)
+                hidden = hidden.reshape(n_chains, n_sequences, n_frames, -1)
+                values = hidden[:, :, min(params.n_lags, n_frames - 1) :]
+        return cls(layers, windows)
+
+    def select(self, sequences):
+        """The past of some sequences only (for a block of work)."""
+        return History(self.layers, [w[:, sequences] for w in self.windows])
+
+    def previous(self, level, sequences):
+        """The last values at ``level`` of ``sequences``: (n_chains, n, n_visible)."""
+        return self.windows[level][:, sequences, 0]
+
+    def biases(self, sequences):
+        """Every layer's dynamic biases for the next frame of ``sequences``.
+
+        Returns a list of arrays of shape ``(n_chains, len(sequences),
+        n_visible + n_hidden)``: the visible biases, then the hidden ones.
+        """
+        biases = []
+        for params, window in zip(self.layers, self.windows, strict=True):
+            past = window[:, sequences]
+            n_chains, n_rows = past.shape[:2]
+            flat = past.reshape(n_chains * n_rows, -1)
+            flat = flat[:, : params.n_lags * params.n_features]
+            both = np.empty(
+                (len(flat), params.n_features + params.n_components), params.dtype
+            )
+            dynamic_biases(params, flat, out=both)
+            biases.append(both.reshape(n_chains, n_rows, -1))
+        return biases
+
+    def push(self, values, sequences, biases):
+        """Append a new frame of ``sequences`` at every layer.
+
+        ``values`` holds the frame's value at the lowest layers, bottom
+        first (at least the frame itself); the layers above get the hidden
+        probabilities of the layer below, given ``biases`` (from
+        :meth:`biases` for this frame).
+        """
+        values = list(values)
+        for k in range(len(values), len(self.layers)):
+            params = self.layers[k - 1]
+            below = values[-1]
+            hidden_bias = biases[k - 1][..., params.n_features :]
+            flat = hidden_probabilities(
+                params,
+                below.reshape(-1, params.n_features),
+                hidden_bias.reshape(-1, params.n_components),
+            )
+            values.append(flat.reshape(*below.shape[:2], -1))
+        for window, value in zip(self.windows, values, strict=True):
+            window[:, sequences, 1:] = window[:, sequences, :-1]
+            window[:, sequences, 0] = value
+
+    def reorder(self, chains, sequences):
+        """Give chain ``i`` of each of ``sequences`` the past of chain ``chains[i]``.
+
+        ``chains`` has shape ``(n_chains, len(sequences))``.
+        """
+        for window in self.windows:
+            window[:, sequences] = window[chains, sequences[None, :]]
+
+
+@dataclass(frozen=True)
+class Observed:
+    """The data of fill-in: frames whose missing entries are to be drawn.
+
+    Attributes
+    ----------
+    X : ndarray of shape (n_frames, n_features)
+        Long format, in the model's dtype; where ``missing`` is True it holds
+        the value a sequence's first frame starts from (e.g. the training
+        mean).
+    missing : ndarray of bool of shape (n_frames, n_features)
+    sequences : Sequences
+    """
+
+    X: np.ndarray
+    missing: np.ndarray
+    sequences: Sequences
+
+
+def run_online(
+    layers,
+    rng,
+    *,
+    history=None,
+    n_steps=None,
+    observed=None,
+    n_chains=1,
+    n_particles=1,
+    n_gibbs=30,
+    scheme=WHOLE_STACK,
+    start_jitter=0.0,
+    hidden_noise=0.0,
+    sample_visibles=False,
+):
+    """Draw frames one after another, each given the chains' own past.
+
+    For every frame, every chain starts a Gibbs run at its previous frame
+    (plus ``N(0, start_jitter^2)`` noise), with the frame's observed
+    channels clamped, and the frame's result joins the chain's past.
+
+    Parameters
+    ----------
+    layers : list of CRBMParameters
+        The model, bottom layer first.
+    rng : numpy.random.Generator
+    history : History, default=None
+        The past the first frame follows (generation).  ``None`` (fill-in
+        only) starts every sequence with no past: its first frame is filled
+        ``FIRST_FRAME_ROUNDS`` times, each time with the latest fill as its
+        own past (edge padding), starting from ``observed.X``.
+    n_steps : int, default=None
+        Frames to generate; with ``observed``, the longest sequence's length.
+    observed : Observed, default=None
+        Fill-in: sequence ``s`` has a frame at step ``t`` while ``t`` is below
+        its length; only frames with a missing entry are drawn, and their
+        observed entries are clamped.  None: generation, every sequence of
+        ``history`` draws every entry of ``n_steps`` frames.
+    n_chains : int, default=1
+        Chains per sequence (``history``'s, when given).
+    n_particles : int, default=1
+        With more than one, chains are groups of this many particles:
+        before each frame, each group is resampled by how well each
+        particle's one-step prediction explains the frame's observed
+        channels (systematic resampling).
+    n_gibbs : int, default=30
+        Alternating Gibbs iterations per frame; the last step is mean field
+        unless ``sample_visibles``.
+    scheme : {"top_layer", "whole_stack"}, default="whole_stack"
+        How a stack draws a frame: :data:`TOP_LAYER` (generation as the
+        original code did it) or :data:`WHOLE_STACK` (needed to clamp).  With
+        one layer both are the same.
+    start_jitter : float, default=0.0
+        Standard deviation of the noise on each chain's start.
+    hidden_noise : float, default=0.0
+        Noise on the (top) hidden biases each time hidden states are drawn
+        (paper §4.3).
+    sample_visibles : bool, default=False
+        Draw the visibles at every step (:func:`gibbs_frames`); one layer,
+        or the top layer with :data:`TOP_LAYER`.
+
+    Yields
+    ------
+    step : int
+    sequences : ndarray of int
+        The sequences that have a frame at this step.
+    drawn : ndarray of int
+        Indices into ``sequences`` of the frames that were drawn.
+    frames : ndarray of shape (n_chains, len(drawn), n_features)
+        Every chain's draw of those frames (observed entries included).
+    """
+    if scheme not in (TOP_LAYER, WHOLE_STACK):
+        raise ValueError(f"unknown scheme {scheme!r}")
+    stacked = len(layers) > 1
+    if stacked and scheme == TOP_LAYER and observed is not None:
+        raise ValueError("a stack can clamp observed channels only with whole_stack")
+    if stacked and scheme == WHOLE_STACK and sample_visibles:
+        raise ValueError("sample_visibles needs one layer or the top_layer scheme")
+
+    def draw(start, biases, clamp):
+        """One Gibbs run per (chain, frame) pair; the frame's lowest values."""
+        shape = start.shape
+        flat = [b.reshape(-1, b.shape[-1]) for b in biases]
+        visible_biases = [
+            b[:, : p.n_features] for p, b in zip(layers, flat, strict=True)
+        ]
+        hidden_biases = [
+            b[:, p.n_features :] for p, b in zip(layers, flat, strict=True)
+        ]
+        start = start.reshape(-1, shape[-1])
+        clamp = None if clamp is None else clamp.reshape(-1, shape[-1])
+        if stacked and scheme == WHOLE_STACK:
+            frame = stacked_gibbs_frames(
+                layers,
+                start,
+                visible_biases,
+                hidden_biases,
+                n_gibbs,
+                rng,
+                hidden_noise=hidden_noise,
+                observed_mask=clamp,
+            )
+            return [frame.reshape(shape)]
+        values = [
+            gibbs_frames(
+                layers[-1],
+                start,
+                visible_biases[-1],
+                hidden_biases[-1],
+                n_gibbs,
+                rng,
+                hidden_noise=hidden_noise,
+                observed_mask=clamp,
+                sample_visibles=sample_visibles,
+            )
+        ]
+        below = zip(layers[-2::-1], visible_biases[-2::-1], strict=True)
+        for params, visible_bias in below:
+            values.insert(0, visible_means(params, values[0], visible_bias))
+        return [v.reshape(*shape[:2], -1) for v in values]
+
+    level = len(layers) - 1 if scheme == TOP_LAYER else 0
+    if observed is None:
+        n_sequences = history.windows[0].shape[1]
+        sequences = np.arange(n_sequences)
+        n_chains = history.windows[0].shape[0]
+        for step in range(n_steps):
+            biases = history.biases(sequences)
+            start = history.previous(level, sequences)
+            if start_jitter:
+                start = start + start_jitter * rng.standard_normal(
+                    start.shape[1:], dtype=start.dtype
+                )
+            values = draw(start, biases, None)
+            yield step, sequences, sequences, values[0]
+            history.push(values, sequences, biases)
+        return
+
+    X, missing, all_sequences = observed.X, observed.missing, observed.sequences
+    starts, lengths = all_sequences.starts, all_sequences.lengths
+    n_features = X.shape[1]
+    n_steps = int(lengths.max(initial=0)) if n_steps is None else n_steps
+    for step in range(n_steps):
+        sequences = np.flatnonzero(lengths > step)
+        rows = starts[sequences] + step
+        frame_missing = missing[rows]
+        drawn = np.flatnonzero(frame_missing.any(axis=1))
+        frames = X[rows]
+        current = np.broadcast_to(frames, (n_chains, *frames.shape)).copy()
+        clamp = np.broadcast_to(
+            ~frame_missing[drawn], (n_chains, len(drawn), n_features)
+        )
+        if history is None:
+            # No past: the frame stands in for it, and the fill is repeated
+            # with the latest fill as the past.
+            for _ in range(FIRST_FRAME_ROUNDS if len(drawn) else 0):
+                start = current[:, drawn]
+                own_past = History.from_frames(layers, start[:, :, None])
+                biases = own_past.biases(np.arange(len(drawn)))
+                current[:, drawn] = draw(start, biases, clamp)[0]
+            history = History.from_frames(layers, current[:, :, None])
+            yield step, sequences, drawn, current[:, drawn]
+            continue
+        if n_particles > 1 and len(drawn):
+            _resample(
+                history,
+                sequences[drawn],
+                frames[drawn],
+                ~frame_missing[drawn],
+                n_particles,
+                rng,
+            )
+        biases = history.biases(sequences)
+        if len(drawn):
+            start = np.where(
+                frame_missing[drawn],
+                history.previous(0, sequences[drawn]),
+                frames[drawn],
+            )
+            if start_jitter:
+                start += start_jitter * rng.standard_normal(start.shape, start.dtype)
+            current[:, drawn] = draw(start, [b[:, drawn] for b in biases], clamp)[0]
+        yield step, sequences, drawn, current[:, drawn]
+        history.push([current], sequences, biases)
+
+
+def _resample(history, sequences, frames, observed, n_particles, rng):
+    """Resample each group of particles by how well they explain the observed data.
+
+    A particle's weight is the likelihood of the frame's observed channels
+    under its own one-step prediction
+    (:func:`~sklearn_crbm._crbm_math.observed_log_likelihood`); each group is
+    resampled (systematic resampling) and the pasts of the chosen ancestors
+    copied, before the frame is drawn.
+    """
+    layers = history.layers
+    n_chains = history.windows[0].shape[0]
+    n_groups = n_chains // n_particles
+    n_features = frames.shape[1]
+    flat = [b.reshape(-1, b.shape[-1]) for b in history.biases(sequences)]
+    prediction = stacked_prediction(
+        layers,
+        [b[:, : p.n_features] for p, b in zip(layers, flat, strict=True)],
+        [b[:, p.n_features :] for p, b in zip(layers, flat, strict=True)],
+        PREDICTION_STEPS,
+    )
+    log_weights = observed_log_likelihood(
+        layers[0],
+        prediction,
+        np.broadcast_to(frames, (n_chains, *frames.shape)).reshape(-1, n_features),
+        np.broadcast_to(observed, (n_chains, *observed.shape)).reshape(-1, n_features),
+    ).reshape(n_groups, n_particles, len(sequences))
+    log_weights -= log_weights.max(axis=1, keepdims=True)
+    cumulative = np.cumsum(np.exp(log_weights), axis=1)
+    cumulative /= cumulative[:, -1:]
+    positions = (
+        rng.random((n_groups, 1, len(sequences))) + np.arange(n_particles)[:, None]
+    ) / n_particles
+    # ancestor of particle i: how many cumulative weights lie below position i
+    ancestors = (cumulative[:, None, :, :] < positions[:, :, None, :]).sum(axis=2)
+    np.minimum(ancestors, n_particles - 1, out=ancestors)
+    chains = ancestors + (np.arange(n_groups) * n_particles)[:, None, None]
+    history.reorder(chains.reshape(n_chains, len(sequences)), sequences)

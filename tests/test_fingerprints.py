@@ -1,0 +1,178 @@
+"""Results pinned across refactors: same ``random_state``, same numbers.
+
+``fingerprints.npz`` (beside this file, in ``data/``) holds what the code of
+commit 502b3cb (before the redesign of issue 13: one on-line loop, one base
+class, one packed parameter storage) computed for the cases below.  It was
+written by running this file as a script on that commit::
+
+    PYTHONPATH=$PWD python tests/test_fingerprints.py
+
+A refactor that keeps the math must keep these numbers: float64 to
+``rtol=1e-12`` (in practice bit for bit), float32 to float32 rounding.  Only
+a deliberate change of the math or of a random stream may rewrite the file,
+and its commit must say which entries changed and why.
+"""
+
+import functools
+from pathlib import Path
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from sklearn_crbm import ConditionalRBM
+from sklearn_crbm._stacked import StackedCRBM
+from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.impute import CRBMImputer
+
+PATH = Path(__file__).parent / "data" / "fingerprints.npz"
+
+X, IDS = make_oscillations(n_sequences=4, n_frames=40, random_state=0)
+X_MISSING = X[IDS == 3].copy()
+X_MISSING[0, :2] = np.nan  # first frame: the edge-padded start
+X_MISSING[15:, :2] = np.nan  # channels lost half-way through
+X_MISSING[25:28] = np.nan  # wholly missing frames
+
+MODELS = {
+    "order2": dict(n_components=8, order=2),
+    "order3_hidden1": dict(n_components=6, order=3, hidden_order=1),
+    "order1_hidden3": dict(n_components=6, order=1, hidden_order=3),
+    "order0": dict(n_components=5, order=0),
+    "noisy_shuffled_cd2": dict(
+        n_components=7,
+        order=2,
+        history_noise=0.5,
+        batching="shuffled",
+        cd_steps=2,
+        batch_size=37,
+    ),
+}
+FITTED = (
+    "components_",
+    "intercept_hidden_",
+    "intercept_visible_",
+    "autoregressive_",
+    "past_to_hidden_",
+    "seed_windows_",
+    "reconstruction_error_",
+)
+
+
+def _crbm(name, dtype, n_iter=7, **extra):
+    model = ConditionalRBM(**MODELS[name], n_iter=n_iter, random_state=0, **extra)
+    return model.fit(X.astype(dtype), sequence_ids=IDS)
+
+
+def _fitted(prefix, model):
+    return {f"{prefix}.{a}": np.asarray(getattr(model, a)) for a in FITTED}
+
+
+def _crbm_results():
+    out = {}
+    for dtype in ("float64", "float32"):
+        for name in MODELS:
+            model = _crbm(name, dtype)
+            out.update(_fitted(f"fit.{name}.{dtype}", model))
+            model.partial_fit(X[IDS < 2].astype(dtype), sequence_ids=IDS[IDS < 2])
+            out.update(_fitted(f"partial_fit.{name}.{dtype}", model))
+            out[f"sample.{name}.{dtype}"] = model.sample(
+                12, n_sequences=3, n_gibbs=5, random_state=1
+            )
+        model = _crbm("order2", dtype)
+        key = f"order2.{dtype}"
+        out[f"transform.{key}"] = model.transform(X, sequence_ids=IDS)
+        out[f"score_samples.{key}"] = model.score_samples(X, sequence_ids=IDS)
+        out[f"predict_next.{key}"] = model.predict_next(X, sequence_ids=IDS)
+        out[f"score.{key}"] = np.array(model.score(X, sequence_ids=IDS))
+        out[f"sample_noise.{key}"] = model.sample(
+            3, n_sequences=260, n_gibbs=4, hidden_noise=0.3, random_state=2
+        )
+        out[f"sample_visibles.{key}"] = model.sample(
+            10, history=X[:5], n_sequences=2, sample_visibles=True, random_state=3
+        )
+    binary = ConditionalRBM(5, order=1, visible_type="binary", n_iter=4, random_state=0)
+    binary.fit((X > 0).astype(float), sequence_ids=IDS)
+    out.update(_fitted("fit.binary.float64", binary))
+    out["sample.binary.float64"] = binary.sample(8, n_sequences=2, random_state=0)
+    return out
+
+
+def _imputer_results():
+    out = {}
+    for dtype in ("float64", "float32"):
+        model = ConditionalRBM(8, order=2, n_iter=10, history_noise=0.3, random_state=0)
+        train = X[IDS < 3].astype(dtype)
+        for particles in (1, 3):
+            imputer = CRBMImputer(
+                model, n_gibbs=4, n_draws=2, n_particles=particles, random_state=0
+            ).fit(train, sequence_ids=IDS[IDS < 3])
+            key = f"particles{particles}.{dtype}"
+            out[f"imputer.transform.{key}"] = imputer.transform(X_MISSING)
+            out[f"imputer.sample.{key}"] = imputer.sample(
+                np.vstack([X_MISSING, X_MISSING]),
+                n_samples=2,
+                sequence_ids=np.repeat([0, 1], len(X_MISSING)),
+                random_state=5,
+            )
+    return out
+
+
+def _stacked_results():
+    out = {}
+    for dtype in ("float64", "float32"):
+        for orders in ((1, None), (2, 1)):
+            stack = StackedCRBM(
+                (8, 4),
+                order=orders[0],
+                hidden_order=orders[1],
+                n_iter=5,
+                random_state=0,
+            ).fit(X.astype(dtype), sequence_ids=IDS)
+            key = f"order{orders[0]}_{orders[1]}.{dtype}"
+            for k, layer in enumerate(stack.layers_):
+                out.update(_fitted(f"stack.layer{k}.{key}", layer))
+            out[f"stack.sample.{key}"] = stack.sample(
+                9, n_sequences=3, n_gibbs=5, hidden_noise=0.2, random_state=1
+            )
+            out[f"stack.transform.{key}"] = stack.transform(X, sequence_ids=IDS)
+            out[f"stack.predict_next.{key}"] = stack.predict_next(X, sequence_ids=IDS)
+        imputer = CRBMImputer(
+            StackedCRBM((8, 4), order=1, n_iter=5, random_state=0),
+            n_gibbs=4,
+            n_particles=2,
+            random_state=0,
+        ).fit(X[IDS < 3].astype(dtype), sequence_ids=IDS[IDS < 3])
+        out[f"stacked_imputer.transform.{dtype}"] = imputer.transform(X_MISSING)
+    return out
+
+
+def compute():
+    return {**_crbm_results(), **_imputer_results(), **_stacked_results()}
+
+
+@pytest.fixture(scope="module")
+def results():
+    return compute()
+
+
+@functools.cache
+def _pinned():
+    with np.load(PATH) as data:
+        return dict(data)
+
+
+def test_fingerprints_are_there():
+    assert PATH.exists(), "run this file as a script on the reference commit"
+
+
+@pytest.mark.parametrize("key", sorted(_pinned()) if PATH.exists() else [])
+def test_unchanged(results, key):
+    expected = _pinned()[key]
+    got = results[key]
+    assert got.dtype == expected.dtype
+    rtol = 1e-12 if expected.dtype == np.float64 else 1e-5
+    assert_allclose(got, expected, rtol=rtol, atol=0)
+
+
+if __name__ == "__main__":
+    np.savez_compressed(PATH, **compute())

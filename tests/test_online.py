@@ -1,0 +1,174 @@
+"""The one on-line loop behind generation and fill-in (``sklearn_crbm._online``)."""
+
+import pickle
+
+import joblib
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+
+from sklearn_crbm import ConditionalRBM, StackedCRBM
+from sklearn_crbm._crbm_math import (
+    CRBMParameters,
+    dynamic_biases,
+    gibbs_frames,
+    hidden_probabilities,
+)
+from sklearn_crbm._online import (
+    TOP_LAYER,
+    WHOLE_STACK,
+    History,
+    Observed,
+    run_online,
+)
+from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.utils._sequences import check_sequence_ids
+
+X, IDS = make_oscillations(n_sequences=3, n_frames=30, random_state=0)
+
+
+def _layers(orders=((2, 2), (1, 3)), seed=0):
+    rng = np.random.default_rng(seed)
+    layers, n_visible = [], 6
+    for k, (order, hidden_order) in enumerate(orders):
+        kind = "gaussian" if k == 0 else "binary"
+        params = CRBMParameters.initialize(
+            n_visible, 5 - k, order, hidden_order, kind, np.float64, rng
+        )
+        params.flat[...] = 0.5 * rng.standard_normal(params.flat.shape)
+        params.dynamic *= params.dynamic_mask()
+        layers.append(params)
+        n_visible = params.n_components
+    return layers
+
+
+def test_history_from_frames_passes_up_with_edge_padding():
+    layers = _layers()
+    frames = X[None, None, :4]  # one chain, one sequence, four frames
+    history = History.from_frames(layers, frames)
+    bottom, top = history.windows
+    assert_array_equal(bottom[0, 0], X[[3, 2]])  # most recent first
+    # layer 1 sees layer 0's hidden probabilities, each frame given its own
+    # past with the first frame repeated where the past runs out
+    padded = [X[max(t - 1, 0)] for t in range(4)], [X[max(t - 2, 0)] for t in range(4)]
+    history_rows = np.hstack([np.array(padded[0]), np.array(padded[1])])
+    _, hidden_bias = dynamic_biases(layers[0], history_rows)
+    hidden = hidden_probabilities(layers[0], X[:4], hidden_bias)
+    # layer 0 has two lags: frames 2 and 3 have a full past; the window of
+    # layer 1 (three lags) repeats the oldest of them
+    assert_allclose(top[0, 0], hidden[[3, 2, 2]], rtol=1e-12)
+
+
+def test_one_layer_schemes_are_one_gibbs_run():
+    (layer,) = _layers(orders=((2, 2),))
+    seed = np.stack([X[:2], X[30:32]])[None]
+    runs = {}
+    for scheme in (TOP_LAYER, WHOLE_STACK):
+        run = run_online(
+            [layer],
+            np.random.default_rng(0),
+            history=History.from_frames([layer], seed),
+            n_steps=4,
+            n_gibbs=3,
+            scheme=scheme,
+            start_jitter=0.01,
+        )
+        runs[scheme] = np.stack([frames for _, _, _, frames in run])
+    assert_array_equal(runs[TOP_LAYER], runs[WHOLE_STACK])
+
+    # the same chains written out: jitter, then gibbs_frames, frame by frame
+    rng = np.random.default_rng(0)
+    past = list(seed[0].transpose(1, 0, 2))
+    for step in range(4):
+        history = np.hstack([past[-1], past[-2]])
+        visible_bias, hidden_bias = dynamic_biases(layer, history)
+        start = past[-1] + 0.01 * rng.standard_normal(past[-1].shape)
+        frame = gibbs_frames(layer, start, visible_bias, hidden_bias, 3, rng)
+        assert_allclose(runs[TOP_LAYER][step, 0], frame, rtol=1e-12)
+        past.append(frame)
+
+
+def test_fill_in_clamps_observed_channels_on_a_stack():
+    layers = _layers()
+    missing = np.zeros(X.shape, dtype=bool)
+    missing[5:, :2] = True
+    missing[12] = True
+    observed = Observed(
+        X=np.where(missing, 0.0, X),
+        missing=missing,
+        sequences=check_sequence_ids(IDS, len(X)),
+    )
+    seen = np.zeros(len(X), dtype=bool)
+    for step, sequences, drawn, frames in run_online(
+        layers,
+        np.random.default_rng(0),
+        observed=observed,
+        n_chains=4,
+        n_particles=2,
+        n_gibbs=2,
+        scheme=WHOLE_STACK,
+    ):
+        rows = 30 * sequences[drawn] + step
+        assert missing[rows].any(axis=1).all()
+        seen[rows] = True
+        assert frames.shape == (4, len(drawn), 6)
+        assert np.isfinite(frames).all()
+        assert_array_equal(
+            frames[:, ~missing[rows]],
+            np.broadcast_to(X[rows][~missing[rows]], (4, (~missing[rows]).sum())),
+        )
+    assert_array_equal(seen, missing.any(axis=1))
+
+
+def test_a_stack_clamps_only_with_the_whole_stack_scheme():
+    layers = _layers()
+    observed = Observed(
+        X=X, missing=np.zeros(X.shape, bool), sequences=check_sequence_ids(IDS, len(X))
+    )
+    with pytest.raises(ValueError, match="whole_stack"):
+        next(
+            run_online(
+                layers, np.random.default_rng(0), observed=observed, scheme=TOP_LAYER
+            )
+        )
+
+
+def test_history_length_is_public_on_both_models():
+    assert ConditionalRBM(order=3, hidden_order=5).history_length == 5
+    assert ConditionalRBM(order=0).history_length == 0
+    assert StackedCRBM((4, 3, 2), order=2).history_length == 6
+
+
+def test_stacked_sample_takes_n_jobs_and_sample_visibles():
+    stack = StackedCRBM((6, 4), order=1, n_iter=3, random_state=0)
+    stack.fit(X, sequence_ids=IDS)
+    serial = stack.sample(3, n_sequences=300, n_gibbs=2, random_state=0)
+    with joblib.parallel_backend("threading"):  # two blocks of 150 sequences
+        parallel = stack.sample(3, n_sequences=300, n_gibbs=2, random_state=0, n_jobs=2)
+    assert_array_equal(serial, parallel)
+    drawn = stack.sample(4, n_sequences=2, sample_visibles=True, random_state=0)
+    assert drawn.shape == (8, 6) and np.isfinite(drawn).all()
+    assert not np.allclose(drawn, stack.sample(4, n_sequences=2, random_state=0))
+
+
+def test_fitted_attributes_view_the_packed_parameters():
+    model = ConditionalRBM(5, order=2, n_iter=2, random_state=0).fit(
+        X, sequence_ids=IDS
+    )
+    for name in (
+        "components_",
+        "intercept_hidden_",
+        "intercept_visible_",
+        "autoregressive_",
+        "past_to_hidden_",
+    ):
+        assert np.shares_memory(getattr(model, name), model._parameters.flat)
+        loaded = pickle.loads(pickle.dumps(model))
+        assert np.shares_memory(getattr(loaded, name), loaded._parameters.flat)
+        assert_array_equal(getattr(loaded, name), getattr(model, name))
+    before = model.transform(X)
+    model.components_ = 2 * model.components_  # assignment writes the model
+    assert not np.allclose(model.transform(X), before)
+    with pytest.raises(ValueError, match=r"components_ has shape \(5, 6\)"):
+        model.components_ = np.zeros((4, 6))
+    assert not hasattr(ConditionalRBM(), "components_")
