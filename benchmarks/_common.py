@@ -11,11 +11,15 @@ import platform
 import statistics
 import sys
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import sklearn
-from threadpoolctl import threadpool_info, threadpool_limits
+import threadpoolctl
+from threadpoolctl import threadpool_info
+
+import sklearn_crbm
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "benchmarks" / "results"
@@ -46,6 +50,21 @@ def add_common_arguments(parser):
 
 
 # ------------------------------------------------------------------ timing
+
+
+@contextmanager
+def threadpool_limits(threads):
+    """``threads`` BLAS threads, for the libraries and the package's loops alike.
+
+    The package picks its own thread count inside its methods
+    (``sklearn_crbm.set_config``); a benchmark row that says 2 threads must
+    run them with 2.
+    """
+    with (
+        threadpoolctl.threadpool_limits(threads),
+        sklearn_crbm.config_context(blas_threads=threads),
+    ):
+        yield
 
 
 def time_call(func, repeats, timer=time.perf_counter):

@@ -146,7 +146,8 @@ def load(data_home):
     train = load_cmu35(data_home, subset="train")
     test = load_cmu35(data_home, subset="test")
     with sklearn.config_context(enable_metadata_routing=True):
-        pre = make_motion_preprocessor(train.skeleton)
+        # the paper's encoding: joint rotations from the rest pose, Taylor's roll
+        pre = make_motion_preprocessor(train.skeleton, reference="rest", roll="taylor")
         Z_train = pre.fit_transform(train.data, sequence_ids=train.sequence_ids)
     cases = {
         (motion, PARTS[part]): case

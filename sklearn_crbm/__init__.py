@@ -7,6 +7,7 @@ preprocessing, on-line filling in of missing channels, and generation.
 """
 
 from . import datasets, metrics, model_selection, plotting, preprocessing
+from ._config import config_context, get_config, set_config
 from ._crbm import ConditionalRBM, TrainingDivergedError
 from ._stacked import StackedCRBM
 from .impute import CRBMImputer, NearestNeighborImputer
@@ -29,10 +30,13 @@ __all__ = [
     "StandardScaler",
     "TrainingDivergedError",
     "__version__",
+    "config_context",
     "datasets",
+    "get_config",
     "make_motion_preprocessor",
     "metrics",
     "model_selection",
     "plotting",
     "preprocessing",
+    "set_config",
 ]

@@ -26,6 +26,7 @@ from .utils._parallel import map_sequence_blocks
 from .utils._persistence import VersionedPickleMixin
 from .utils._random import rng_from
 from .utils._sequences import check_sequence_ids
+from .utils._threads import frame_rows, limit_blas_threads, sequence_rows
 
 __all__ = ["BaseCRBM", "check_count", "seed_frames"]
 
@@ -169,6 +170,7 @@ class BaseCRBM(
             )
         return representations
 
+    @limit_blas_threads(frame_rows)
     def transform(self, X, *, sequence_ids=None):
         """Hidden probabilities of the top layer, frame by frame.
 
@@ -195,6 +197,7 @@ class BaseCRBM(
         X, sequences = self._check_inference_input(X, sequence_ids)
         return self._representations(X, sequences, self._layer_parameters())[-1]
 
+    @limit_blas_threads(frame_rows)
     def predict_next(self, X, *, sequence_ids=None):
         """One-step-ahead prediction of every frame from its history alone.
 
@@ -247,6 +250,7 @@ class BaseCRBM(
             position += len(rows)
         return predicted
 
+    @limit_blas_threads(frame_rows)
     def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
         """Negative one-step-ahead prediction error; higher is better.
 
@@ -296,6 +300,7 @@ class BaseCRBM(
 
     # ----------------------------------------------------------- generation
 
+    @limit_blas_threads(sequence_rows)
     def sample(
         self,
         n_samples,

@@ -27,6 +27,7 @@ from .utils._sequences import (
     frame_history,
     shuffled_batches,
 )
+from .utils._threads import batch_rows, frame_rows, limit_blas_threads
 
 
 class TrainingDivergedError(FloatingPointError):
@@ -220,6 +221,7 @@ class ConditionalRBM(BaseCRBM):
 
     # ------------------------------------------------------------------ fit
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None, *, sequence_ids=None):
         """Train the model on sequences of frames.
@@ -247,6 +249,7 @@ class ConditionalRBM(BaseCRBM):
             self.seed_windows_ = self._pick_seed_windows(X, sequences)
         return self
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def partial_fit(self, X, y=None, *, sequence_ids=None):
         """Train for one epoch on the given sequences, keeping the current state.
@@ -338,6 +341,9 @@ class ConditionalRBM(BaseCRBM):
         self._parameters = params
         self._velocity = params.zeros_like(layout="F")
 
+    # Diverging weights overflow in the products before the epoch's check
+    # raises TrainingDivergedError, which says what to do.
+    @np.errstate(over="ignore", invalid="ignore")
     def _train(self, X, frames, n_epochs):
         # trained in the layout BLAS runs fastest, kept in C order when fitted
         params = self._parameters.copy(layout="F")
@@ -399,6 +405,7 @@ class ConditionalRBM(BaseCRBM):
                 )
         self._parameters = params.copy(layout="C")
 
+    @limit_blas_threads(frame_rows)
     def score_samples(self, X, *, sequence_ids=None):
         """Negative free energy ``-F(x_t | history)`` of every frame.
 

@@ -12,6 +12,7 @@ from ._base import BaseCRBM
 from ._crbm import ConditionalRBM
 from .utils._random import rng_from
 from .utils._sequences import check_sequence_ids
+from .utils._threads import batch_rows, limit_blas_threads
 
 __all__ = ["StackedCRBM"]
 
@@ -251,6 +252,7 @@ class StackedCRBM(BaseCRBM):
 
     # ------------------------------------------------------------------ fit
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None, *, sequence_ids=None):
         """Train the layers greedily, bottom first.
@@ -288,6 +290,7 @@ class StackedCRBM(BaseCRBM):
         self.seed_windows_ = self._pick_seed_windows(X, sequences)
         return self
 
+    @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
     def partial_fit(self, X, y=None, *, sequence_ids=None):
         """Train every layer for one epoch on the given sequences.

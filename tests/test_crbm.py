@@ -12,6 +12,7 @@ compares against sums over the 2^H hidden configurations.
 
 import copy
 import itertools
+import warnings
 
 import numpy as np
 import pytest
@@ -23,7 +24,7 @@ from sklearn.preprocessing import StandardScaler
 
 from sklearn_crbm import ConditionalRBM, TrainingDivergedError
 from sklearn_crbm._crbm_math import cd_gradients, hidden_probabilities
-from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.datasets import load_cmu35, make_oscillations
 from sklearn_crbm.utils._random import rng_from
 from sklearn_crbm.utils._sequences import balanced_batches, frame_history
 
@@ -536,6 +537,18 @@ def test_divergence_raises_naming_the_learning_rate():
         pytest.raises(TrainingDivergedError, match="learning_rate=50.0"),
     ):
         model.fit(X * 100, sequence_ids=ids)
+
+
+def test_unscaled_data_gives_the_clear_error_and_no_overflow_warning(data_home):
+    cmu = load_cmu35(data_home, subset="train")  # Euler angles in degrees
+    model = ConditionalRBM(50, n_iter=20, random_state=0)
+    with (
+        warnings.catch_warnings(),
+        np.errstate(all="warn"),
+        pytest.raises(TrainingDivergedError, match="standardise the data"),
+    ):
+        warnings.simplefilter("error")
+        model.fit(cmu.data, sequence_ids=cmu.sequence_ids)
 
 
 def test_pipeline_routes_sequence_ids():

@@ -10,6 +10,7 @@ from sklearn.base import (
     _fit_context,
     clone,
 )
+from sklearn.frozen import FrozenEstimator
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import HasMethods, Interval, MissingValues
 from sklearn.utils.validation import check_is_fitted
@@ -22,6 +23,7 @@ from ..utils._parallel import map_sequence_blocks
 from ..utils._persistence import VersionedPickleMixin
 from ..utils._random import rng_from
 from ..utils._sequences import Sequences, check_sequence_ids
+from ..utils._threads import chain_rows, limit_blas_threads
 from ._base import check_imputer_input, complete_runs
 
 # history_noise of the default model: removes the drift of on-line fill-in on
@@ -50,7 +52,10 @@ class CRBMImputer(
     Parameters
     ----------
     estimator : ConditionalRBM or StackedCRBM, default=None
-        The model, cloned and trained by :meth:`fit`.  ``None`` means
+        The model, cloned and trained by :meth:`fit`.  A model fitted
+        already is used as it is, without training, when wrapped in
+        :class:`sklearn.frozen.FrozenEstimator`:
+        ``CRBMImputer(FrozenEstimator(model))``.  ``None`` means
         ``ConditionalRBM(history_noise=0.8)``: trained on noisy histories so
         that on-line fills do not drift (see Notes; with the paper's plain
         schedule the filled upper body of a walk drifts for some training
@@ -83,11 +88,16 @@ class CRBMImputer(
         split depends on the data only, so the fills are the same for every
         ``n_jobs``.  ``None`` means 1 unless in a
         :func:`joblib.parallel_backend` context; ``-1`` means all processors.
+    verbose : int, default=0
+        With ``verbose > 0``, :meth:`fit` says what it trains and the model
+        reports its progress every ``verbose`` epochs (the model's own
+        ``verbose``, when that is 0, is set to this value for training).
 
     Attributes
     ----------
     estimator_ : ConditionalRBM or StackedCRBM
-        The fitted clone of ``estimator``.
+        The fitted clone of ``estimator``, or the model inside a
+        ``FrozenEstimator`` (not a copy).
     mean_ : ndarray of shape (`n_features_in_`,)
         Mean training frame: where the missing channels of the first frame
         of a sequence start.
@@ -194,6 +204,7 @@ class CRBMImputer(
         "missing_values": [MissingValues()],
         "random_state": ["random_state"],
         "n_jobs": [None, Integral],
+        "verbose": ["verbose"],
     }
 
     # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
@@ -211,6 +222,7 @@ class CRBMImputer(
         missing_values=np.nan,
         random_state=None,
         n_jobs=None,
+        verbose=0,
     ):
         self.estimator = estimator
         self.n_gibbs = n_gibbs
@@ -219,6 +231,7 @@ class CRBMImputer(
         self.missing_values = missing_values
         self.random_state = random_state
         self.n_jobs = n_jobs
+        self.verbose = verbose
 
     @_fit_context(prefer_skip_nested_validation=False)
     def fit(self, X, y=None, *, sequence_ids=None):
@@ -247,9 +260,22 @@ class CRBMImputer(
             estimator = self.estimator
             if estimator is None:
                 estimator = ConditionalRBM(history_noise=DEFAULT_HISTORY_NOISE)
-            self.estimator_ = clone(estimator).fit(X, sequence_ids=run_ids)
+            if isinstance(estimator, FrozenEstimator):
+                self.estimator_ = _check_frozen(estimator.estimator, X.shape[1])
+            else:
+                self.estimator_ = self._train(clone(estimator), X, run_ids)
             self.mean_ = X.mean(axis=0)
         return self
+
+    def _train(self, estimator, X, sequence_ids):
+        if self.verbose:
+            if estimator.get_params().get("verbose", 1) == 0:
+                estimator.set_params(verbose=self.verbose)
+            print(
+                f"[{type(self).__name__}] training {estimator!r} on {len(X)} "
+                f"complete frames in {len(np.unique(sequence_ids))} sequences"
+            )
+        return estimator.fit(X, sequence_ids=sequence_ids)
 
     def fit_transform(self, X, y=None, *, sequence_ids=None):
         """Fit on ``X``, then fill its missing values on-line.
@@ -273,6 +299,7 @@ class CRBMImputer(
             X, sequence_ids=sequence_ids
         )
 
+    @limit_blas_threads(chain_rows)
     def transform(self, X, *, sequence_ids=None):
         """Fill every missing value of ``X`` on-line.
 
@@ -292,6 +319,7 @@ class CRBMImputer(
         """
         return self._impute(X, sequence_ids, self.n_draws, self.random_state, True)
 
+    @limit_blas_threads(chain_rows)
     def sample(self, X, n_samples=1, *, sequence_ids=None, random_state=None):
         """Draw independent on-line fills of ``X`` (multiple imputation).
 
@@ -398,3 +426,19 @@ class CRBMImputer(
         tags = super().__sklearn_tags__()
         tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
         return tags
+
+
+def _check_frozen(model, n_features):
+    """The fitted model inside a ``FrozenEstimator``, checked against the data."""
+    check_is_fitted(
+        model,
+        msg="CRBMImputer got FrozenEstimator(%(name)s) with an unfitted model: "
+        "fit the model first, or pass it without FrozenEstimator to train it.",
+    )
+    if model.n_features_in_ != n_features:
+        raise ValueError(
+            f"The frozen {type(model).__name__} was fitted on "
+            f"{model.n_features_in_} features but X has {n_features}: fit the "
+            "imputer on data with the model's features (same preprocessing)."
+        )
+    return model

@@ -82,6 +82,23 @@ def _columns(features, names, n_features):
     return np.asarray(columns, dtype=np.intp)
 
 
+def _forward_feature(names):
+    """The one feature named ``"{root}_dforward"``, or a ValueError."""
+    if names is None:
+        raise ValueError(
+            "forward_speed needs the forward-displacement channel: pass feature= "
+            "(its name or column index), or feature_names=... or a DataFrame with "
+            "a column named '{root}_dforward' (RootRelativeEncoder's output)."
+        )
+    found = [str(n) for n in names if str(n).endswith("_dforward")]
+    if len(found) != 1:
+        raise ValueError(
+            f"forward_speed found {len(found)} features named '{{root}}_dforward' "
+            f"({found}); pass feature= to choose the forward-displacement channel."
+        )
+    return found[0]
+
+
 def _check_last_frames(last_frames):
     if last_frames is None:
         return None
@@ -117,7 +134,7 @@ def forward_speed(
     X,
     *,
     sequence_ids=None,
-    feature="root_dforward",
+    feature=None,
     feature_names=None,
     last_frames=None,
 ):
@@ -125,7 +142,8 @@ def forward_speed(
 
     The mean over the frames of each sequence of the channel that holds the
     body's forward displacement from one frame to the next (``root_dforward``
-    of :class:`~sklearn_crbm.preprocessing.RootRelativeEncoder`).  Pass the
+    of :class:`~sklearn_crbm.preprocessing.RootRelativeEncoder`, named
+    ``"{root}_dforward"`` after the skeleton's root bone).  Pass the
     motion in the encoder's units (undo the standard scaling first) to get
     length units per frame; standardised motion gives the same ranking.
 
@@ -135,8 +153,11 @@ def forward_speed(
         Motion, all sequences stacked in long format.
     sequence_ids : array-like of shape (n_frames,), default=None
         Sequence id of every frame; ``None`` means one sequence.
-    feature : str or int, default="root_dforward"
-        The forward-displacement channel, by name or column index.
+    feature : str or int or None, default=None
+        The forward-displacement channel, by name or column index.  None
+        takes the one feature whose name ends in ``"_dforward"``
+        (``root_dforward`` for CMU data, ``Hips_dforward`` for a root called
+        ``Hips``).
     feature_names : array-like of str, default=None
         Names of the columns of ``X``; default the columns of a DataFrame.
     last_frames : int, default=None
@@ -159,6 +180,8 @@ def forward_speed(
     array([0.7, 2.2])
     """
     X, sequences, names = _check_motion(X, sequence_ids, feature_names)
+    if feature is None:
+        feature = _forward_feature(names)
     columns = _columns(feature, names, X.shape[1])
     if len(columns) != 1:
         raise ValueError("forward_speed needs exactly one feature.")

@@ -231,7 +231,14 @@ class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         """
         check_is_fitted(self)
         copy = self.copy if copy is None else copy
-        X = check_array(X, dtype=FLOAT_DTYPES, copy=copy, ensure_all_finite="allow-nan")
+        # every feature may be constant (a one-frame file): then X has 0 columns
+        X = check_array(
+            X,
+            dtype=FLOAT_DTYPES,
+            copy=copy,
+            ensure_all_finite="allow-nan",
+            ensure_min_features=0,
+        )
         keep = ~self.constant_mask_
         if X.shape[1] != keep.sum():
             raise ValueError(

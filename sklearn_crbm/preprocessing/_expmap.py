@@ -17,6 +17,7 @@ from ..utils._rotations import (
     expmap_to_matrix,
     matrix_to_euler,
     matrix_to_expmap,
+    mean_rotation,
     unwrap_expmap,
 )
 from ..utils._sequences import check_sequence_ids
@@ -24,6 +25,7 @@ from ._layout import (
     check_encoded,
     expmap_layout,
     find_euler_blocks,
+    moving_root,
     skeleton_feature_names,
 )
 
@@ -67,11 +69,26 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         by the equivalent map ``r + 2 pi k r / |r|`` closest to the previous
         frame's, so the maps are continuous in time; the first frame of each
         sequence keeps its angle in ``[0, pi]``.
+    reference : {"rest", "mean"}, default="rest"
+        What each bone's rotation is measured from.  ``"rest"``: the rest
+        pose (the skeleton's zero angles), as in the paper.  ``"mean"``: the
+        bone's mean rotation over the data seen in :meth:`fit`, so that the
+        maps stay far from a rotation of pi, where they would jump, unless a
+        bone turns more than pi away from its mean (with ``"rest"``, a joint
+        that sits near pi from its rest pose, such as a thigh in some BVH
+        rigs, jumps back and forth).  The root is always measured from the
+        rest pose, since :class:`RootRelativeEncoder` reads its global
+        orientation: the first bone whose translation channels (``tx``,
+        ``ty``, ``tz``) move in the data, as in :class:`RootRelativeEncoder`.
 
     Attributes
     ----------
     encoded_bones_ : list of str
         The bones whose Euler channels are encoded, in output order.
+    reference_rotations_ : ndarray of shape (n_encoded_bones, 3, 3)
+        The rotation each bone's map is measured from: the map encodes
+        ``reference_rotations_[i].T @ R`` for the bone's rotation ``R``.  The
+        identity for ``reference="rest"`` and for the root.
     n_features_in_ : int
         Number of features seen during :term:`fit`.
     feature_names_in_ : ndarray of shape (`n_features_in_`,)
@@ -132,12 +149,16 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         "skeleton": "no_validation",
         "angle_unit": [StrOptions({"deg", "rad"})],
         "continuous": ["boolean"],
+        "reference": [StrOptions({"rest", "mean"})],
     }
 
-    def __init__(self, skeleton=None, *, angle_unit="deg", continuous=False):
+    def __init__(
+        self, skeleton=None, *, angle_unit="deg", continuous=False, reference="rest"
+    ):
         self.skeleton = skeleton
         self.angle_unit = angle_unit
         self.continuous = continuous
+        self.reference = reference
 
     def _input_names(self, n_features):
         if hasattr(self, "feature_names_in_"):
@@ -184,8 +205,25 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
             names, self._blocks
         )
         self._names_in = np.asarray(names, dtype=object)
+        self.reference_rotations_ = self._fit_references(X)
         self.encoded_bones_ = [b.bone for b in self._blocks]
         return self
+
+    def _fit_references(self, X):
+        """Each block's reference rotation: identity, or the bone's mean rotation."""
+        references = np.broadcast_to(np.eye(3), (len(self._blocks), 3, 3)).copy()
+        if self.reference == "rest":
+            return references
+        root = moving_root(self._names_in, X, self.skeleton)
+        for i, block in enumerate(self._blocks):
+            if block.bone != root:
+                R = euler_to_matrix(X[:, list(block.columns)] * self._scale(), block.axes)
+                references[i] = mean_rotation(R)
+        return references
+
+    def _scale(self):
+        """Radians per unit of the Euler channels."""
+        return np.pi / 180.0 if self.angle_unit == "deg" else 1.0
 
     def fit_transform(self, X, y=None, *, sequence_ids=None):
         """Fit to ``X`` and encode it.
@@ -239,11 +277,12 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
         out = np.empty((X.shape[0], len(self._names_out)), dtype=np.float64)
         out[:, self._passthrough[:, 0]] = X[:, self._passthrough[:, 1]]
-        scale = np.pi / 180.0 if self.angle_unit == "deg" else 1.0
         for axes, members in self._groups().items():
             cols = np.array([self._blocks[i].columns for i in members])
-            angles = X[:, cols] * scale  # (n_frames, n_bones, k)
-            r = matrix_to_expmap(euler_to_matrix(angles, axes))
+            angles = X[:, cols] * self._scale()  # (n_frames, n_bones, k)
+            reference = self.reference_rotations_[members]
+            R = np.swapaxes(reference, -1, -2) @ euler_to_matrix(angles, axes)
+            r = matrix_to_expmap(R)
             if self.continuous:
                 for start, stop in zip(sequences.starts, sequences.stops, strict=True):
                     r[start:stop] = unwrap_expmap(r[start:stop])
@@ -272,11 +311,11 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         check_sequence_ids(sequence_ids, X.shape[0])
         out = np.empty((X.shape[0], self.n_features_in_), dtype=np.float64)
         out[:, self._passthrough[:, 1]] = X[:, self._passthrough[:, 0]]
-        scale = 180.0 / np.pi if self.angle_unit == "deg" else 1.0
         for axes, members in self._groups().items():
             starts = self._block_starts[members]
             r = X[:, starts[:, None] + np.arange(3)]
-            angles = matrix_to_euler(expmap_to_matrix(r), axes) * scale
+            R = self.reference_rotations_[members] @ expmap_to_matrix(r)
+            angles = matrix_to_euler(R, axes) / self._scale()
             cols = np.array([self._blocks[i].columns for i in members])
             out[:, cols] = angles
         return out

@@ -155,6 +155,33 @@ def find_euler_blocks(feature_names, skeleton=None):
     return blocks
 
 
+def moving_root(feature_names, X, skeleton=None):
+    """The bone that carries the body's position: the encoders' root.
+
+    The first bone, in column order, with all three translation channels
+    ``"{bone}_tx"``, ``"{bone}_ty"``, ``"{bone}_tz"`` whose translations
+    move in ``X``.  Usually the skeleton's root; but some rigs put a static
+    bone above the moving pelvis (the Bandai Namco files: ``joint_Root``,
+    always at the origin, above ``Hips``), and then the pelvis is the root.
+    When no translation moves (a one-frame file), the first bone with
+    translation channels; without any, the skeleton's first bone (or None).
+    """
+    names = [str(n) for n in feature_names]
+    column = {n: j for j, n in enumerate(names)}
+    candidates = []
+    for name in names:
+        bone = name[: -len("_tx")] if name.endswith("_tx") else None
+        if bone is not None and all(f"{bone}_t{a}" in column for a in "yz"):
+            candidates.append(bone)
+    for bone in candidates:
+        T = X[:, [column[f"{bone}_t{a}"] for a in "xyz"]]
+        if np.any(np.nanmax(T, axis=0, initial=-np.inf) > np.nanmin(T, axis=0, initial=np.inf)):
+            return bone
+    if candidates:
+        return candidates[0]
+    return skeleton.bones[0].name if skeleton is not None else None
+
+
 def expmap_layout(feature_names, blocks):
     """Output names and column map after replacing Euler blocks by exp maps.
 

@@ -1,5 +1,7 @@
 """Global root <-> body-centred, ground-plane-invariant root."""
 
+import warnings
+
 import numpy as np
 from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
 from sklearn.utils._param_validation import StrOptions
@@ -10,15 +12,28 @@ from sklearn.utils.validation import (
 )
 
 from ..utils._persistence import VersionedPickleMixin
-from ..utils._rotations import expmap_to_matrix, matrix_to_expmap
+from ..utils._rotations import (
+    euler_to_matrix,
+    expmap_to_matrix,
+    matrix_to_euler,
+    matrix_to_expmap,
+)
 from ..utils._sequences import check_sequence_ids
-from ._layout import check_encoded, expmap_feature_names
+from ._layout import (
+    check_encoded,
+    check_skeleton,
+    expmap_feature_names,
+    moving_root,
+)
 
 __all__ = ["RootRelativeEncoder"]
 
 _ROOT_IN = ("tx", "ty", "tz", "ex", "ey", "ez")
 _ROOT_OUT = ("pitch", "roll", "dheading", "dforward", "dsideways", "height")
 _AXES = {"x": 0, "y": 1, "z": 2}
+# Frames whose forward axis lies within this angle of the vertical have an
+# ill-defined heading; if most frames do, the up axis is probably wrong.
+_STEEP_FORWARD_DEG = 30.0
 
 
 def _wrap(angle):
@@ -29,24 +44,35 @@ def _wrap(angle):
 class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
     """Make the root invariant to ground-plane translation and heading.
 
-    The root's global position (``root_tx``, ``root_ty``, ``root_tz``) and
-    orientation (exponential map ``root_ex``, ``root_ey``, ``root_ez``)
-    become six body-centred channels, as in the paper (§3) and in Taylor's
-    ``preprocess1``:
+    The root's global position (``{root}_tx``, ``{root}_ty``, ``{root}_tz``)
+    and orientation (exponential map ``{root}_ex``, ``{root}_ey``,
+    ``{root}_ez``) become six body-centred channels, as in the paper (§3)
+    and in Taylor's ``preprocess1``.  ``{root}`` is the name of the root
+    bone: ``root`` for CMU ASF/AMC data (so the channels are ``root_pitch``,
+    ...), ``Hips`` or ``joint_Root`` for many BVH files (``Hips_pitch``,
+    ...).  The root orientation is split as ``R = R_up(heading) @
+    R_left(pitch - pi/2) @ R_forward(roll - pi/2)`` (a yaw-pitch-roll
+    decomposition about the body's forward and left axes, see ``up_axis``):
 
-    ``root_pitch``
-        Angle (radians) between the body's forward axis and the downward
-        vertical: pi/2 when the body is upright, less when it leans forward.
-    ``root_roll``
-        Angle between the body's left axis and the downward vertical.
-    ``root_dheading``
+    ``{root}_pitch``
+        Angle (radians, ``[0, pi]``) between the body's forward axis and the
+        downward vertical: pi/2 when the body is upright, less when it leans
+        forward.
+    ``{root}_roll``
+        Rotation of the body about its forward axis, plus pi/2 (radians,
+        ``(-pi/2, 3 pi/2]``): pi/2 when the left axis is horizontal, more
+        when the body leans to its right, pi + pi/2 upside down.  With
+        ``roll="taylor"``: the angle between the left axis and the downward
+        vertical, in ``[0, pi]``, as in Taylor's code (the same for an upright
+        body that does not pitch; see Notes).
+    ``{root}_dheading``
         Change of heading (rotation about the vertical, radians, wrapped to
         ``[-pi, pi)``) from this frame to the next.
-    ``root_dforward``, ``root_dsideways``
+    ``{root}_dforward``, ``{root}_dsideways``
         Ground-plane displacement from this frame to the next, along the
         body's forward direction and to its right, in the heading of this
         frame.
-    ``root_height``
+    ``{root}_height``
         The root's height above the ground plane (absolute).
 
     The six columns stand where the first of the six root channels stood;
@@ -58,25 +84,40 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
     Parameters
     ----------
     skeleton : Skeleton or None, default=None
-        Gives the up axis (``skeleton.up_axis``) and, for a plain array, the
-        column layout: the skeleton's channels after :class:`ExpMapEncoder`
-        (each Euler block replaced by ``_ex, _ey, _ez``), in the skeleton's
-        order.  Input with feature names (a DataFrame) is always located by
-        name.  Without names and without a skeleton, the first six columns
-        are taken as ``tx, ty, tz, ex, ey, ez`` (the ASF/BVH layout after
-        :class:`ExpMapEncoder`).
+        Gives the root's name, the up axis (``skeleton.up_axis``) and, for a
+        plain array, the column layout: the skeleton's channels after
+        :class:`ExpMapEncoder` (each Euler block replaced by ``_ex, _ey,
+        _ez``), in the skeleton's order.  Input with feature names (a
+        DataFrame) is always located by name.  Without names and without a
+        skeleton, the first six columns are taken as ``tx, ty, tz, ex, ey,
+        ez`` (the ASF/BVH layout after :class:`ExpMapEncoder`).
     up_axis : {"x", "y", "z"} or None, default=None
         The vertical axis of the world frame.  None takes the skeleton's, or
         ``"y"`` (CMU, BVH) without a skeleton; Taylor's MIT data is ``"z"``.
         The body's forward axis is the next axis cyclically after the up
         axis and its left axis the one after that (z up: forward x, left y,
-        as in the MIT data; y up: forward z, left x, as in CMU).
-    root : str, default="root"
+        as in the MIT data; y up: forward z, left x, as in CMU and most BVH
+        files).  :meth:`fit` warns when the root's forward axis points
+        nearly straight up or down in most frames, the sign of a wrong up
+        axis (the round trip stays exact, but heading is then ill-defined).
+    root : str or None, default=None
         Name of the root bone: the encoder reads ``"{root}_tx"``, ... and
-        writes ``"{root}_pitch"``, ....
+        writes ``"{root}_pitch"``, ....  None takes the first bone whose
+        translation channels move in the data seen in :meth:`fit`: the
+        skeleton's root (its first bone), except in rigs that put a static
+        bone above the moving pelvis (the Bandai Namco files: ``joint_Root``
+        above ``Hips``); ``"root"`` for a plain array without a skeleton.
+    roll : {"euler", "taylor"}, default="euler"
+        ``"euler"`` gives every orientation, upside down included, an exact
+        inverse.  ``"taylor"`` reproduces Taylor's ``preprocess1`` (the
+        paper's encoding), which cannot tell an orientation from its mirror
+        image once the body's up axis points below the horizon: then
+        :meth:`transform` warns and names the frames.
 
     Attributes
     ----------
+    root_ : str
+        Name of the root bone used.
     root_columns_ : ndarray of shape (6,)
         Input columns of ``tx, ty, tz, ex, ey, ez``.
     up_axis_ : str
@@ -98,10 +139,19 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
     from a start pose with heading 0 and ground position (0, 0) at the first
     frame of every sequence, and rebuilds the root orientation from pitch,
     roll and heading.  The result equals the original up to a rotation about
-    the vertical and a ground-plane translation per sequence, exactly so for
-    every orientation whose body up axis points above the horizon (the left
-    axis is otherwise only determined up to a mirror image).  The root
-    exponential map comes back with rotation angle in ``[0, pi]``.
+    the vertical and a ground-plane translation per sequence (the *start
+    pose*), to rounding error for every orientation.  Where the forward axis
+    points straight up or down (pitch 0 or pi, e.g. half-way through a flip)
+    heading and roll turn about the same axis: the split between them is
+    then arbitrary and they jump by pi, but their sum, and so the
+    orientation, is exact.  The root exponential map comes back with
+    rotation angle in ``[0, pi]``.
+
+    With ``roll="taylor"`` the round trip is exact only while the body's up
+    axis points above the horizon; for the other frames the left axis comes
+    back mirrored.  The two rolls agree when the body does not pitch; CMU
+    walking (pitch within 0.3 of pi/2) differs by a few thousandths of a
+    radian.
 
     Examples
     --------
@@ -131,13 +181,24 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
     _parameter_constraints: dict = {
         "skeleton": "no_validation",
         "up_axis": [StrOptions({"x", "y", "z"}), None],
-        "root": [str],
+        "root": [str, None],
+        "roll": [StrOptions({"euler", "taylor"})],
     }
 
-    def __init__(self, skeleton=None, *, up_axis=None, root="root"):
+    def __init__(self, skeleton=None, *, up_axis=None, root=None, roll="euler"):
         self.skeleton = skeleton
         self.up_axis = up_axis
         self.root = root
+        self.roll = roll
+
+    def _root_name(self, names, X):
+        if self.root is not None:
+            return self.root
+        if names is None:
+            return "root"
+        if self.skeleton is not None:
+            check_skeleton(self.skeleton)
+        return moving_root(names, X, self.skeleton) or "root"
 
     def _layout_names(self, n_features):
         if hasattr(self, "feature_names_in_"):
@@ -182,7 +243,8 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             raise ValueError(f"up_axis must be 'x', 'y' or 'z', got {up!r}.")
         self.up_axis_ = up
         names = self._layout_names(X.shape[1])
-        wanted = [f"{self.root}_{c}" for c in _ROOT_IN]
+        root = self._root_name(names, X)
+        wanted = [f"{root}_{c}" for c in _ROOT_IN]
         if names is None:
             if X.shape[1] < 6:
                 raise ValueError(
@@ -197,16 +259,24 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             missing = [w for w in wanted if w not in position]
             if missing:
                 hint = ""
-                if any(f"{self.root}_r{a}" in position for a in "xyz"):
+                if any(f"{root}_r{a}" in position for a in "xyz"):
                     hint = (
                         " The root still has Euler channels: apply ExpMapEncoder first."
                     )
+                elif all(w[len(root) :] not in ("_ex", "_ey", "_ez") for w in missing):
+                    hint = (
+                        f" The root bone {root!r} needs position channels (tx, ty, "
+                        "tz) as well as rotations."
+                    )
                 raise ValueError(
                     f"X lacks the root channels {missing}; RootRelativeEncoder "
-                    f"needs {wanted}.{hint}"
+                    f"needs {wanted} (root={root!r}: pass root= to name another "
+                    f"bone).{hint}"
                 )
             columns = np.array([position[w] for w in wanted])
         self.root_columns_ = columns
+        self.root_ = root
+        self._check_up_axis(X)
         self._names_in = np.asarray(names, dtype=object)
         others = np.setdiff1d(np.arange(X.shape[1]), columns)
         first = columns.min()
@@ -218,6 +288,41 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         ).astype(np.intp)
         self._root_out = len(before) + np.arange(6)
         return self
+
+    def _check_up_axis(self, X):
+        """Warn when the forward axis is steep in most frames: a wrong up axis."""
+        R = self._local_rotations(X[:, self.root_columns_[3:]])
+        R = R[np.all(np.isfinite(R), axis=(1, 2))]
+        if len(R) == 0:
+            return
+        steep = np.abs(R[:, 2, 0]) > np.cos(np.deg2rad(_STEEP_FORWARD_DEG))
+        if steep.mean() <= 0.5:
+            return
+        # the world axis that the root's up axis (taken to be the same letter
+        # as the world's) points along in most frames
+        u = _AXES[self.up_axis_]
+        body_up = expmap_to_matrix(X[:, self.root_columns_[3:]])[:, :, u]
+        best = "xyz"[int(np.argmax(np.nanmean(np.abs(body_up), axis=0)))]
+        forward = "xyz"[self._permutation()[0]]
+        warnings.warn(
+            f"The root's forward axis ({forward}, the axis after the up axis "
+            f"{self.up_axis_!r}) points within {_STEEP_FORWARD_DEG:g} degrees of "
+            f"the vertical in {steep.mean():.0%} of the frames, so heading is "
+            "ill-defined (the round trip stays exact). Is the up axis right? "
+            + (
+                f"The root's {self.up_axis_} axis points mostly along the world's "
+                f"{best} axis: try up_axis={best!r}."
+                if best != self.up_axis_
+                else "Pass up_axis= to name the vertical axis."
+            ),
+            UserWarning,
+            stacklevel=4,
+        )
+
+    def _local_rotations(self, expmaps):
+        """Root rotations in (forward, left, up) coordinates."""
+        perm = self._permutation()
+        return expmap_to_matrix(expmaps)[:, perm][:, :, perm]
 
     def fit_transform(self, X, y=None, *, sequence_ids=None):
         """Fit to ``X`` and encode it; see :meth:`transform`.
@@ -268,13 +373,14 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
         perm = self._permutation()
         position = X[:, self.root_columns_[:3]][:, perm]
-        R = expmap_to_matrix(X[:, self.root_columns_[3:]])
-        R = R[:, perm][:, :, perm]  # the same rotation in (forward, left, up) axes
-        forward = R[:, :, 0]
-        left = R[:, :, 1]
-        pitch = np.arccos(np.clip(-forward[:, 2], -1.0, 1.0))
-        roll = np.arccos(np.clip(-left[:, 2], -1.0, 1.0))
-        heading = np.arctan2(forward[:, 1], forward[:, 0])
+        R = self._local_rotations(X[:, self.root_columns_[3:]])
+        if self.roll == "taylor":
+            pitch, roll, heading = self._taylor_angles(R)
+        else:
+            # R = R_z(heading) R_y(pi/2 - pitch) R_x(roll - pi/2), exactly
+            tilt_roll, tilt_pitch, heading = np.moveaxis(matrix_to_euler(R, "xyz"), -1, 0)
+            pitch = np.pi / 2 - tilt_pitch
+            roll = tilt_roll + np.pi / 2
 
         n = X.shape[0]
         dheading = np.zeros(n)
@@ -296,6 +402,52 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         root = np.column_stack([pitch, roll, deltas, position[:, 2]])
         out[:, self._root_out] = root
         return out
+
+    def _taylor_angles(self, R):
+        """Taylor's pitch, roll and heading; warns about frames it cannot invert."""
+        forward = R[:, :, 0]
+        left = R[:, :, 1]
+        pitch = np.arccos(np.clip(-forward[:, 2], -1.0, 1.0))
+        roll = np.arccos(np.clip(-left[:, 2], -1.0, 1.0))
+        heading = np.arctan2(forward[:, 1], forward[:, 0])
+        # the inverse takes the left axis on the upper side of the horizontal
+        # perpendicular to the forward axis; frames on the other side come back
+        # mirrored
+        horizontal = np.stack(
+            [-np.sin(heading), np.cos(heading), np.zeros_like(heading)], axis=1
+        )
+        mirrored = np.flatnonzero(np.sum(left * horizontal, axis=1) < -1e-9)
+        if len(mirrored):
+            shown = ", ".join(str(i) for i in mirrored[:10])
+            more = f" and {len(mirrored) - 10} more" if len(mirrored) > 10 else ""
+            warnings.warn(
+                f"RootRelativeEncoder(roll='taylor') cannot encode frames {shown}"
+                f"{more} (row numbers of X): the body's up axis points below the "
+                "horizon, and inverse_transform will return those frames mirrored. "
+                "Use roll='euler' (the default) for an exact round trip.",
+                UserWarning,
+                stacklevel=4,
+            )
+        return pitch, roll, heading
+
+    def _taylor_rotations(self, pitch, roll, heading):
+        """Root rotations from Taylor's angles, taking the up axis above the horizon."""
+        n = len(pitch)
+        ch, sh = np.cos(heading), np.sin(heading)
+        cp, sp = np.cos(pitch), np.sin(pitch)
+        zeros = np.zeros(n)
+        h_vec = np.column_stack([ch, sh, zeros])
+        g_vec = np.column_stack([-sh, ch, zeros])
+        z_vec = np.column_stack([zeros, zeros, np.ones(n)])
+        forward = sp[:, None] * h_vec - cp[:, None] * z_vec
+        e_vec = cp[:, None] * h_vec + sp[:, None] * z_vec
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sin_phi = np.clip(-np.cos(roll) / sp, -1.0, 1.0)
+        sin_phi = np.where(sp > 0, sin_phi, 0.0)
+        cos_phi = np.sqrt(np.maximum(1.0 - sin_phi**2, 0.0))
+        left = cos_phi[:, None] * g_vec + sin_phi[:, None] * e_vec
+        up = np.cross(forward, left)
+        return np.stack([forward, left, up], axis=2)
 
     def inverse_transform(self, X, *, sequence_ids=None):
         """Integrate the body-centred root back to a global root.
@@ -338,22 +490,11 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             ground[start + 1 : stop] = np.cumsum(steps, axis=0)
         heading = _wrap(heading)
 
-        # forward = sin(pitch) h + ... ; see the class Notes
-        ch, sh = np.cos(heading), np.sin(heading)
-        cp, sp = np.cos(pitch), np.sin(pitch)
-        zeros = np.zeros(n)
-        h_vec = np.column_stack([ch, sh, zeros])
-        g_vec = np.column_stack([-sh, ch, zeros])
-        z_vec = np.column_stack([zeros, zeros, np.ones(n)])
-        forward = sp[:, None] * h_vec - cp[:, None] * z_vec
-        e_vec = cp[:, None] * h_vec + sp[:, None] * z_vec
-        with np.errstate(divide="ignore", invalid="ignore"):
-            sin_phi = np.clip(-np.cos(roll) / sp, -1.0, 1.0)
-        sin_phi = np.where(sp > 0, sin_phi, 0.0)
-        cos_phi = np.sqrt(np.maximum(1.0 - sin_phi**2, 0.0))
-        left = cos_phi[:, None] * g_vec + sin_phi[:, None] * e_vec
-        up = np.cross(forward, left)
-        R_local = np.stack([forward, left, up], axis=2)
+        if self.roll == "taylor":
+            R_local = self._taylor_rotations(pitch, roll, heading)
+        else:
+            angles = np.column_stack([roll - np.pi / 2, np.pi / 2 - pitch, heading])
+            R_local = euler_to_matrix(angles, "xyz")
 
         perm = self._permutation()
         inv = np.argsort(perm)
@@ -388,7 +529,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             names_in = _check_feature_names_in(self, input_features)
         out = np.empty(self.n_features_in_, dtype=object)
         out[self._pass_out] = np.asarray(names_in, dtype=object)[self._pass_in]
-        out[self._root_out] = [f"{self.root}_{c}" for c in _ROOT_OUT]
+        out[self._root_out] = [f"{self.root_}_{c}" for c in _ROOT_OUT]
         return out
 
     def __sklearn_is_fitted__(self):

@@ -25,6 +25,7 @@ __all__ = [
     "expmap_to_matrix",
     "matrix_to_euler",
     "matrix_to_expmap",
+    "mean_rotation",
     "unwrap_expmap",
 ]
 
@@ -366,3 +367,39 @@ def unwrap_expmap(r):
         k = np.where(moving, k, 0.0)
         r[t] = (theta[t] + two_pi * k)[..., None] * n[t]
     return r
+
+
+def mean_rotation(R):
+    """The rotation closest to the mean of rotation matrices (chordal L2 mean).
+
+    Parameters
+    ----------
+    R : array-like of shape (n, 3, 3)
+        Rotation matrices; those with a NaN are ignored.
+
+    Returns
+    -------
+    mean : ndarray of shape (3, 3)
+        The rotation ``Q`` that minimises ``sum ||Q - R_i||_F^2``: the
+        arithmetic mean of the matrices projected onto the rotations by an
+        SVD.  The identity when no matrix is finite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn_crbm.utils._rotations import euler_to_matrix, mean_rotation
+    >>> R = euler_to_matrix(np.deg2rad([[170.0], [-170.0]]), "x")
+    >>> mean_rotation(R).round(12) + 0.0  # 180 degrees about x
+    array([[ 1.,  0.,  0.],
+           [ 0., -1.,  0.],
+           [ 0.,  0., -1.]])
+    """
+    R = np.asarray(R, dtype=np.float64)
+    if R.ndim != 3 or R.shape[1:] != (3, 3):
+        raise ValueError(f"R must have shape (n, 3, 3), got {R.shape}.")
+    R = R[np.all(np.isfinite(R), axis=(1, 2))]
+    if len(R) == 0:
+        return np.eye(3)
+    U, _, Vt = np.linalg.svd(R.mean(axis=0))
+    D = np.diag([1.0, 1.0, np.linalg.det(U @ Vt)])
+    return U @ D @ Vt

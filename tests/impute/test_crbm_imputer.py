@@ -4,6 +4,8 @@ import numpy as np
 import pytest
 import sklearn
 from numpy.testing import assert_allclose, assert_array_equal
+from sklearn.exceptions import NotFittedError
+from sklearn.frozen import FrozenEstimator
 from sklearn.pipeline import make_pipeline
 
 from sklearn_crbm import ConditionalRBM
@@ -211,6 +213,59 @@ def test_default_estimator_is_a_conditional_rbm():
     imputer = CRBMImputer(n_gibbs=2).fit(X[:, :3], sequence_ids=ids)
     assert type(imputer.estimator_) is ConditionalRBM
     assert imputer.estimator is None
+
+
+def test_frozen_fitted_model_is_used_without_training(test_data):
+    X, ids = make_oscillations(n_sequences=6, n_frames=40, n_features=5, random_state=0)
+    params = dict(n_components=12, order=2, n_iter=20, random_state=0)
+    model = ConditionalRBM(**params).fit(X, sequence_ids=ids)
+    weights = model.components_.copy()
+    # fit data the model has never seen: training on it would change the weights
+    X_other, ids_other = make_oscillations(
+        n_sequences=2, n_frames=30, n_features=5, random_state=7
+    )
+    frozen = CRBMImputer(FrozenEstimator(model), n_gibbs=5, random_state=0)
+    frozen.fit(X_other, sequence_ids=ids_other)
+    assert frozen.estimator_ is model
+    assert model.n_iter_ == 20
+    assert_array_equal(model.components_, weights)
+    # fills as an imputer that trained the same model on the same data
+    frozen.fit(X, sequence_ids=ids)  # mean_ (where first frames start) from X
+    trained = CRBMImputer(ConditionalRBM(**params), n_gibbs=5, random_state=0)
+    trained.fit(X, sequence_ids=ids)
+    X_test, test_ids = test_data
+    X_missing = X_test.copy()
+    X_missing[10:, :2] = np.nan
+    assert_array_equal(
+        frozen.transform(X_missing, sequence_ids=test_ids),
+        trained.transform(X_missing, sequence_ids=test_ids),
+    )
+
+
+def test_frozen_model_must_be_fitted_on_the_same_features():
+    X, ids = make_oscillations(n_sequences=2, n_frames=20, n_features=3, random_state=0)
+    unfitted = FrozenEstimator(ConditionalRBM(4, order=2))
+    with pytest.raises(NotFittedError, match="unfitted model: fit the model first"):
+        CRBMImputer(unfitted).fit(X, sequence_ids=ids)
+    model = ConditionalRBM(4, order=2, n_iter=2, random_state=0).fit(X[:, :2])
+    with pytest.raises(ValueError, match="fitted on 2 features but X has 3"):
+        CRBMImputer(FrozenEstimator(model)).fit(X, sequence_ids=ids)
+
+
+def test_verbose_reports_training(capsys):
+    X, ids = make_oscillations(n_sequences=2, n_frames=20, n_features=3, random_state=0)
+    model = ConditionalRBM(4, order=2, n_iter=4, random_state=0)
+    CRBMImputer(model, verbose=2).fit(X, sequence_ids=ids)
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("[CRBMImputer] training ConditionalRBM(")
+    assert lines[0].endswith("on 40 complete frames in 2 sequences")
+    assert [line.split(",")[0] for line in lines[1:]] == [
+        "[ConditionalRBM] Iteration 2",
+        "[ConditionalRBM] Iteration 4",
+    ]
+    assert model.verbose == 0  # the clone was told, not the user's model
+    CRBMImputer(model).fit(X, sequence_ids=ids)
+    assert capsys.readouterr().out == ""
 
 
 def test_metadata_routing_passes_sequence_ids(monkeypatch):

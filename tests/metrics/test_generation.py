@@ -44,6 +44,19 @@ def test_forward_speed_is_the_per_sequence_mean_of_the_named_channel():
     assert forward_speed(X, sequence_ids=ids, feature=0, last_frames=10)[0] == 5.0
 
 
+def test_forward_speed_finds_the_channel_of_any_root():
+    X = np.vstack([gait(30, speed=0.7), gait(21, speed=2.0)])
+    ids = np.repeat([0, 1], 150)
+    hips = NAMES.copy()
+    hips[0] = "Hips_dforward"
+    assert_allclose(
+        forward_speed(X, sequence_ids=ids, feature_names=hips), [0.7, 2.0], atol=0.01
+    )
+    two = np.array(["Hips_dforward", "root_dforward", "a", "b"], dtype=object)
+    with pytest.raises(ValueError, match=r"found 2 .*Hips_dforward.*feature="):
+        forward_speed(X, feature_names=two)
+
+
 @pytest.mark.parametrize("period", [20, 30, 45])
 def test_step_frequency_finds_the_gait_cycle(period):
     X = gait(period, noise=0.1)

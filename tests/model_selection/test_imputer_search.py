@@ -37,8 +37,11 @@ def motion(data_home):
     bunch = load_cmu35(data_home, subset="train")
     keep = np.isin(bunch.sequence_ids, TRIALS)
     X, ids = bunch.data[keep], bunch.sequence_ids[keep]
+    # The paper's encoding, in which the numbers below were measured.  (With
+    # the default one, from each joint's mean rotation, this 16-unit, 30-epoch
+    # CRBM loses one of the three splits to nearest neighbour by 0.006.)
     with sklearn.config_context(enable_metadata_routing=True):
-        pre = make_motion_preprocessor(bunch.skeleton)
+        pre = make_motion_preprocessor(bunch.skeleton, reference="rest", roll="taylor")
         Z = pre.fit_transform(X, sequence_ids=ids)
     return Z, ids, pre.get_feature_names_out()
 

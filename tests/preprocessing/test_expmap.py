@@ -240,3 +240,34 @@ def test_nan_propagates_to_its_bone_only():
     nan_columns = set(np.flatnonzero(np.isnan(Z).any(axis=0)))
     assert nan_columns == {out.index(f"ltibia_{c}") for c in ("ex", "ey", "ez")}
     assert np.isnan(Z).sum() == 3
+
+
+def test_mean_reference_measures_bones_from_their_mean_but_not_the_root():
+    walker = make_walker(n_sequences=2, n_frames=40, random_state=0)
+    X = walker.data.copy()
+    femur = [list(walker.feature_names).index(f"lfemur_r{a}") for a in "xyz"]
+    X[:, femur[0]] += 175.0  # the thigh sits near pi from its rest pose
+    rest = ExpMapEncoder(walker.skeleton).fit(X)
+    mean = ExpMapEncoder(walker.skeleton, reference="mean").fit(X)
+    names = list(mean.get_feature_names_out())
+    assert names == list(rest.get_feature_names_out())
+    R = euler_to_matrix(np.deg2rad(X[:, femur]), "xyz")
+    M = mean.reference_rotations_[mean.encoded_bones_.index("lfemur")]
+    # the chordal mean: the rotation nearest to the mean matrix
+    assert np.allclose(M.T @ M, np.eye(3)) and np.linalg.det(M) > 0
+    U, _, Vt = np.linalg.svd(R.mean(axis=0))
+    assert np.allclose(M, U @ Vt)
+    cols = [names.index(f"lfemur_e{a}") for a in "xyz"]
+    Z_rest, Z_mean = rest.transform(X), mean.transform(X)
+    assert np.allclose(expmap_to_matrix(Z_mean[:, cols]), M.T @ R)
+    assert np.linalg.norm(Z_rest[:, cols], axis=1).max() > 2.5
+    assert np.linalg.norm(Z_mean[:, cols], axis=1).max() < 0.6
+    # the root keeps its global orientation, for RootRelativeEncoder
+    assert np.array_equal(mean.reference_rotations_[0], np.eye(3))
+    root = [names.index(f"root_e{a}") for a in "xyz"]
+    assert np.array_equal(Z_mean[:, root], Z_rest[:, root])
+    back = mean.inverse_transform(Z_mean)
+    # every bone's rotation comes back (the thigh as an equivalent triple)
+    rotations = walker.skeleton.local_rotations(X)
+    assert np.abs(walker.skeleton.local_rotations(back) - rotations).max() < 1e-13
+

@@ -82,7 +82,8 @@ def test_cmu_gives_the_papers_62_dimensions(cmu):
 
 
 def test_mit_gives_49_dimensions_equal_to_the_tsbn_file(mit, data_home):
-    pre = make_motion_preprocessor(mit.skeleton)
+    # the paper's encoding: rotations from the rest pose, Taylor's roll
+    pre = make_motion_preprocessor(mit.skeleton, reference="rest", roll="taylor")
     Z = pre.fit_transform(mit.data, sequence_ids=mit.sequence_ids)
     assert Z.shape == (3826, 49)
     tsbn = scipy.io.loadmat(data_home / "mit_tsbn" / "mit_mocap.mat")
@@ -185,3 +186,19 @@ def test_works_without_metadata_routing(cmu):
         Z = pre.fit_transform(cmu.data)  # one sequence
         assert Z.shape == (2813, 62)
         assert pre.inverse_transform(Z).shape == cmu.data.shape
+
+
+def test_sequence_ids_without_routing_says_how_to_turn_it_on():
+    walker = make_walker(n_sequences=2, n_frames=20, random_state=0)
+    pre = make_motion_preprocessor(walker.skeleton)
+    with sklearn.config_context(enable_metadata_routing=False):
+        for method in (pre.fit, pre.fit_transform):
+            with pytest.raises(
+                ValueError, match=r"sklearn\.set_config\(enable_metadata_routing=True\)"
+            ):
+                method(walker.data, sequence_ids=walker.sequence_ids)
+        # without sequence_ids: one sequence, no routing needed
+        assert pre.fit_transform(walker.data).shape == walker.data.shape
+    with sklearn.config_context(enable_metadata_routing=True):
+        Z = pre.fit_transform(walker.data, sequence_ids=walker.sequence_ids)
+    assert Z.shape == walker.data.shape

@@ -1,6 +1,7 @@
 """RootRelativeEncoder: global root <-> body-centred root."""
 
 import pickle
+import warnings
 
 import numpy as np
 import pytest
@@ -8,7 +9,11 @@ import scipy.io
 
 from sklearn_crbm.datasets import load_cmu35, load_mit_walk, make_walker
 from sklearn_crbm.preprocessing import ExpMapEncoder, RootRelativeEncoder
-from sklearn_crbm.utils._rotations import expmap_to_matrix
+from sklearn_crbm.utils._rotations import (
+    euler_to_matrix,
+    expmap_to_matrix,
+    matrix_to_expmap,
+)
 
 ROOT_OUT = [
     "root_pitch",
@@ -56,7 +61,7 @@ def test_mit_equals_taylors_motion_mat(mit, data_home):
     tilt forward, tilt left, d heading, d forward, d sideways, height."""
     motion = scipy.io.loadmat(data_home / "taylor_theano_motion" / "motion.mat")
     expected = np.vstack([m for m in motion["Motion"].flat])
-    encoder = RootRelativeEncoder(mit.skeleton)
+    encoder = RootRelativeEncoder(mit.skeleton, roll="taylor")
     Z = encoder.fit_transform(mit.data, sequence_ids=mit.sequence_ids)
     assert encoder.up_axis_ == "z"
     assert list(encoder.get_feature_names_out()[:6]) == ROOT_OUT
@@ -226,3 +231,86 @@ def test_wrong_column_count_at_transform_raises(cmu_expmap):
 def test_bad_up_axis_raises():
     with pytest.raises(ValueError, match="up_axis"):
         RootRelativeEncoder(up_axis="w").fit(np.zeros((3, 6)))
+
+
+def _random_root(n, seed, up):
+    """Root channels (tx, ty, tz, ex, ey, ez) with uniformly random orientations,
+    a few exactly at gimbal lock (forward axis straight up or down)."""
+    from scipy.spatial.transform import Rotation
+
+    u = "xyz".index(up)
+    forward, left = (u + 1) % 3, (u + 2) % 3
+    maps = Rotation.random(n, random_state=seed).as_rotvec()
+    # heading about the vertical, then the forward axis turned onto it
+    headings = Rotation.from_rotvec(np.outer([0.3, -2.0, 3.0, 1.0], np.eye(3)[u]))
+    tilts = Rotation.from_rotvec(np.outer([1, -1, 1, -1], np.pi / 2 * np.eye(3)[left]))
+    maps[:4] = (headings * tilts).as_rotvec()
+    R = Rotation.from_rotvec(maps[:4]).as_matrix()
+    assert np.allclose(np.abs(R[:, u, forward]), 1.0, atol=1e-15)
+    rng = np.random.default_rng(seed)
+    return np.column_stack([rng.normal(size=(n, 3)) * 10.0, maps])
+
+
+@pytest.mark.parametrize("up", ["x", "y", "z"])
+def test_every_orientation_round_trips_upside_down_included(up):
+    X = _random_root(400, seed=0, up=up)
+    encoder = RootRelativeEncoder(up_axis=up).fit(X)
+    E = encoder.transform(X)
+    back = encoder.inverse_transform(E)
+    u = "xyz".index(up)
+    rot_err, pos_err = _align_and_compare(
+        X, back, np.zeros(len(X)), [0, 1, 2], [3, 4, 5], up=u
+    )
+    assert rot_err < 1e-12 and pos_err < 1e-10
+    assert np.all((E[:, 0] >= 0) & (E[:, 0] <= np.pi))  # pitch
+    assert np.all((E[:, 1] > -np.pi / 2) & (E[:, 1] <= 1.5 * np.pi))  # roll
+
+
+def test_taylors_roll_matches_the_exact_roll_when_upright_and_warns_otherwise():
+    X = _random_root(400, seed=1, up="y")
+    euler = RootRelativeEncoder(up_axis="y").fit(X)
+    with pytest.warns(UserWarning, match=r"cannot encode frames \d+, \d+"):
+        taylor = RootRelativeEncoder(up_axis="y", roll="taylor").fit_transform(X)
+    E = euler.transform(X)
+    # the same pitch, deltas and height (away from the four frames at gimbal
+    # lock, where the heading is arbitrary)
+    same = [0, 2, 3, 4, 5]
+    assert np.allclose(E[4:, same], taylor[4:, same], atol=1e-9)
+    # the two rolls agree for a body that leans sideways but does not pitch:
+    # R = R_y(heading) R_z(lean), z being the forward axis when y is up
+    lean = np.tile([0.3, -0.5, 0.0, 1.2], 100)
+    heading = np.linspace(-3.0, 3.0, 400)
+    X[:, 3:6] = matrix_to_expmap(euler_to_matrix(np.column_stack([lean, heading]), "zy"))
+    E = euler.transform(X)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        taylor = RootRelativeEncoder(up_axis="y", roll="taylor").fit_transform(X)
+    assert np.allclose(E[:, 0], np.pi / 2, atol=1e-12)
+    assert np.allclose(E[:, 1], taylor[:, 1], atol=1e-12)
+    assert np.allclose(E[:, 1], np.pi / 2 + lean, atol=1e-12)
+
+
+def test_the_root_is_the_skeletons_first_bone():
+    walker = make_walker(n_sequences=1, n_frames=10, random_state=0)
+    bones = list(walker.skeleton.bones)
+    renamed = [
+        type(b)(
+            "Hips" if b.name == "root" else b.name,
+            "Hips" if b.parent == "root" else b.parent,
+            b.direction,
+            b.length,
+            b.channels,
+            b.rotation_order,
+        )
+        for b in bones
+    ]
+    skeleton = type(walker.skeleton)(renamed)
+    X = ExpMapEncoder(skeleton).fit_transform(walker.data)
+    encoder = RootRelativeEncoder(skeleton).fit(X)
+    assert encoder.root_ == "Hips"
+    assert list(encoder.get_feature_names_out()[:2]) == ["Hips_pitch", "Hips_roll"]
+    assert np.array_equal(
+        encoder.transform(X), RootRelativeEncoder(walker.skeleton).fit(X).transform(X)
+    )
+    with pytest.raises(ValueError, match=r"root='pelvis'.*pass root="):
+        RootRelativeEncoder(skeleton, root="pelvis").fit(X)

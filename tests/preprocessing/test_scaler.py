@@ -108,3 +108,12 @@ def test_inverse_with_wrong_width_raises(data):
         scaler.inverse_transform(data)
     with pytest.raises(ValueError, match="X has 5 features"):
         scaler.transform(data[:, :5])
+
+
+def test_a_single_frame_drops_every_channel_and_comes_back():
+    X = np.array([[1.0, -2.0, 3.5]])
+    scaler = StandardScaler().fit(X)
+    Z = scaler.transform(X)
+    assert Z.shape == (1, 0)
+    assert np.array_equal(scaler.inverse_transform(Z), X)
+    assert scaler.get_feature_names_out().shape == (0,)

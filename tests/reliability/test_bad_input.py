@@ -294,6 +294,13 @@ ENTRIES = [
         lambda c, X: c.f["scaler"].inverse_transform(X),
         allows_nan=True,
         overrides=(
+            # 0 columns is valid input where every channel is constant (one
+            # frame); here 4 are kept, so it is the wrong count
+            (
+                "no columns",
+                ValueError,
+                "X has 0 features, but .* expects 4 features",
+            ),
             (
                 "wrong column count",
                 ValueError,
@@ -325,6 +332,13 @@ ENTRIES = [
         lambda c: c.P,
         lambda c, X: c.f["preprocessor"].inverse_transform(X),
         allows_nan=True,
+        overrides=(
+            (
+                "no columns",
+                ValueError,
+                "X has 0 features, but StandardScaler.inverse_transform expects 33",
+            ),
+        ),
     ),
     Entry(
         "fillin_error",
@@ -1050,9 +1064,15 @@ OTHER_PARAMS = [
     ),
     Case(
         "metrics.forward_speed(feature by name without names)",
-        lambda c: metrics.forward_speed(c.X),
+        lambda c: metrics.forward_speed(c.X, feature="root_dforward"),
         ValueError,
         "Feature 'root_dforward' is given by name, but X has no feature names",
+    ),
+    Case(
+        "metrics.forward_speed(default feature without names)",
+        lambda c: metrics.forward_speed(c.X),
+        ValueError,
+        r"forward_speed needs the forward-displacement channel: pass feature=",
     ),
     Case(
         "metrics.motion_amplitude(features=[unknown name])",

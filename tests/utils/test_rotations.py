@@ -216,3 +216,24 @@ def test_unwrap_expmap_vectorised_over_bones_and_keeps_identity():
     assert np.allclose(unwrap_expmap(r), r)
     with pytest.raises(ValueError, match="shape"):
         unwrap_expmap(np.zeros(3))
+
+
+def test_mean_rotation_is_the_chordal_mean():
+    from sklearn_crbm.utils._rotations import mean_rotation
+
+    rotations = Rotation.random(50, random_state=0)
+    spread = Rotation.from_rotvec(0.3 * rotations.as_rotvec() / np.pi)
+    centre = Rotation.from_rotvec([0.2, 2.9, -0.4])  # near pi from the identity
+    R = (centre * spread).as_matrix()
+    M = mean_rotation(R)
+    assert np.allclose(M @ M.T, np.eye(3)) and np.isclose(np.linalg.det(M), 1.0)
+    # no rotation is closer to the matrices in the Frobenius sense
+    cost = lambda Q: np.sum((R - Q) ** 2)  # noqa: E731
+    for other in Rotation.random(200, random_state=1).as_matrix():
+        assert cost(M) <= cost(other)
+    nudged = Rotation.from_rotvec([1e-3, 0, 0]).as_matrix() @ M
+    assert cost(M) < cost(nudged)
+    # NaN frames are ignored; none finite gives the identity
+    with_nan = np.concatenate([R, np.full((3, 3, 3), np.nan)])
+    assert np.allclose(mean_rotation(with_nan), M)
+    assert np.array_equal(mean_rotation(np.full((2, 3, 3), np.nan)), np.eye(3))

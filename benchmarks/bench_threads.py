@@ -1,0 +1,192 @@
+"""The demo's training with the default environment against one BLAS thread.
+
+numpy and scipy each load their own OpenBLAS, which by default starts one
+thread per core.  The package picks its own thread count for its loops
+(``sklearn_crbm.set_config(blas_threads="auto")``, one thread at batch 100);
+this script checks that a user who changes nothing gets one-thread speed.
+
+It trains the demo's model (``python -m sklearn_crbm demo``: CMU subject 35
+preprocessed, 200 hidden units, order 3, ``history_noise=0.8``, seed 0) for
+``--epochs`` epochs, each run in a fresh Python process, in three
+environments:
+
+- ``default``: no ``*_NUM_THREADS`` variable set, the package's defaults;
+- ``one thread``: ``OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1``, the speed to
+  match;
+- ``all threads``: the default environment with
+  ``sklearn_crbm.set_config(blas_threads=<cores>)``, what every call did
+  before the package chose (``--old-epochs`` epochs: it can be very slow).
+
+Each is run ``--repeats`` times, alternating, on the quiet machine and again
+while a busy process of this script's own spins on one core ("loaded").
+Reports milliseconds per epoch (median of the repeats; a warm-up epoch is
+not timed) and the ratio of default to one thread; done when it is at most
+1.2 both quiet and loaded.
+
+Run from the repository root::
+
+    python benchmarks/bench_threads.py            # about two minutes
+
+Prints a table and writes ``benchmarks/results/bench_threads.json``.
+"""
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from _common import DEFAULT_DATA_HOME, print_table, write_json
+
+THREAD_VARIABLES = (
+    "OPENBLAS_NUM_THREADS",
+    "OMP_NUM_THREADS",
+    "MKL_NUM_THREADS",
+    "BLIS_NUM_THREADS",
+    "VECLIB_MAXIMUM_THREADS",
+    "NUMEXPR_NUM_THREADS",
+)
+TARGET = 1.2
+
+
+def environments():
+    """``name -> (environment variables, package blas_threads setting)``."""
+    default = {k: v for k, v in os.environ.items() if k not in THREAD_VARIABLES}
+    one = {**default, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    return {
+        "default": (default, None),
+        "one thread": (one, None),
+        "all threads": (default, os.cpu_count()),
+    }
+
+
+def train_in_child(data_home, epochs, blas_threads):
+    """Child process: ms per epoch of the demo's training."""
+    import sklearn
+
+    import sklearn_crbm
+    from sklearn_crbm import ConditionalRBM
+    from sklearn_crbm._cli import _parser
+    from sklearn_crbm.datasets import load_cmu35
+    from sklearn_crbm.preprocessing import make_motion_preprocessor
+
+    if blas_threads is not None:
+        sklearn_crbm.set_config(blas_threads=blas_threads)
+    demo = _parser().parse_args(["demo"])
+    train = load_cmu35(data_home, subset="train")
+    with sklearn.config_context(enable_metadata_routing=True):
+        pre = make_motion_preprocessor(train.skeleton)
+        Z = pre.fit_transform(train.data, sequence_ids=train.sequence_ids)
+
+    def model(n_iter):
+        return ConditionalRBM(
+            demo.n_components,
+            order=demo.order,
+            n_iter=n_iter,
+            history_noise=demo.history_noise,
+            random_state=demo.seed,
+        )
+
+    model(1).fit(Z, sequence_ids=train.sequence_ids)  # warm up
+    start = time.perf_counter()
+    model(epochs).fit(Z, sequence_ids=train.sequence_ids)
+    seconds = time.perf_counter() - start
+    print(json.dumps({"ms_per_epoch": 1000 * seconds / epochs}))
+
+
+def run_child(env, blas_threads, data_home, epochs):
+    command = [sys.executable, __file__, "--child", "--data-home", str(data_home)]
+    command += ["--epochs", str(epochs)]
+    if blas_threads is not None:
+        command += ["--child-blas-threads", str(blas_threads)]
+    result = subprocess.run(
+        command, env=env, capture_output=True, text=True, check=False
+    )
+    if result.returncode != 0:
+        raise RuntimeError(result.stderr[-3000:])
+    return json.loads(result.stdout.strip().splitlines()[-1])["ms_per_epoch"]
+
+
+def measure(load, args):
+    busy = None
+    if load == "loaded":
+        busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+        time.sleep(1.0)
+    try:
+        times = {name: [] for name in environments()}
+        for _ in range(args.repeats):
+            for name, (env, blas_threads) in environments().items():
+                epochs = args.old_epochs if name == "all threads" else args.epochs
+                times[name].append(run_child(env, blas_threads, args.data_home, epochs))
+    finally:
+        if busy is not None:
+            busy.terminate()
+            busy.wait()
+    return {name: statistics.median(values) for name, values in times.items()}, times
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument(
+        "--data-home",
+        type=Path,
+        default=Path(os.environ.get("SKLEARN_CRBM_DATA", DEFAULT_DATA_HOME)),
+        help="folder holding cmu_subject35/ (default: ../shared/data)",
+    )
+    parser.add_argument("--epochs", type=int, default=100, help="timed epochs")
+    parser.add_argument(
+        "--old-epochs", type=int, default=10, help="timed epochs of 'all threads'"
+    )
+    parser.add_argument("--repeats", type=int, default=3, help="runs per row")
+    parser.add_argument("--output", default=None, help="JSON file to write")
+    parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--child-blas-threads", type=int, help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        train_in_child(args.data_home, args.epochs, args.child_blas_threads)
+        return
+
+    rows, raw = [], {}
+    for load in ("quiet", "loaded"):
+        medians, raw[load] = measure(load, args)
+        for name, ms in medians.items():
+            rows.append(
+                {
+                    "load": load,
+                    "environment": name,
+                    "ms": ms,
+                    "ratio": ms / medians["one thread"],
+                }
+            )
+    print_table(
+        rows,
+        [
+            ("load", "machine", "s"),
+            ("environment", "BLAS threads", "s"),
+            ("ms", "ms per epoch", ".1f"),
+            ("ratio", "x one thread", ".2f"),
+        ],
+        title=f"The demo's training, {os.cpu_count()} cores, median of "
+        f"{args.repeats} runs ({args.epochs} epochs; 'all threads': "
+        f"{args.old_epochs})",
+    )
+    ratios = {
+        row["load"]: row["ratio"] for row in rows if row["environment"] == "default"
+    }
+    met = all(r <= TARGET for r in ratios.values())
+    print(
+        f"default / one thread: quiet {ratios['quiet']:.2f}, loaded "
+        f"{ratios['loaded']:.2f} (target <= {TARGET}): {'met' if met else 'NOT met'}"
+    )
+    write_json(
+        "bench_threads",
+        {"rows": rows, "runs_ms_per_epoch": raw, "target": TARGET, "met": met},
+        args.output,
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,121 @@
+"""The package's choice of BLAS threads (sklearn_crbm.utils._threads)."""
+
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+from threadpoolctl import ThreadpoolController, threadpool_limits
+
+import sklearn_crbm
+from sklearn_crbm import ConditionalRBM, CRBMImputer, StackedCRBM
+from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.utils._threads import (
+    MIN_WORK_PER_THREAD,
+    auto_blas_threads,
+    limit_blas_threads,
+)
+
+
+def blas_threads():
+    """Threads each loaded BLAS library (numpy's, scipy's) may use now."""
+    return [
+        lib.num_threads
+        for lib in ThreadpoolController().select(user_api="blas").lib_controllers
+    ]
+
+
+@pytest.fixture
+def two_threads():
+    """BLAS allowed two threads where the machine has them; the count allowed."""
+    with threadpool_limits(2, user_api="blas"):
+        yield min(blas_threads())
+
+
+class Recorder:
+    """A stand-in estimator whose method notes the BLAS threads it runs with."""
+
+    order, hidden_order, batch_size = 3, None, 100
+
+    def __init__(self, n_components):
+        self.n_components = n_components
+        self.seen = []
+
+    @limit_blas_threads(lambda self, X: len(X))
+    def run(self, X):
+        self.seen.append(blas_threads())
+        return self
+
+
+def test_auto_blas_threads_counts_work_per_thread():
+    assert auto_blas_threads(0, 8) == 1
+    assert auto_blas_threads(MIN_WORK_PER_THREAD - 1, 8) == 1
+    assert auto_blas_threads(2 * MIN_WORK_PER_THREAD, 8) == 2
+    assert auto_blas_threads(5 * MIN_WORK_PER_THREAD, 8) == 5
+    assert auto_blas_threads(50 * MIN_WORK_PER_THREAD, 8) == 8
+    assert auto_blas_threads(50 * MIN_WORK_PER_THREAD, 1) == 1
+
+
+def test_paper_size_runs_on_one_thread_and_restores(two_threads):
+    # batch 100 x 200 hidden x 62 features x 4 (frame and 3 past): 5e6 multiply-adds
+    recorder = Recorder(200).run(np.zeros((100, 62)))
+    assert recorder.seen == [[1, 1]]
+    assert min(blas_threads()) == two_threads
+
+
+def test_large_products_use_the_threads_allowed(two_threads):
+    # 1000 rows x 1000 hidden x 100 features x 4: 4e8 multiply-adds
+    recorder = Recorder(1000).run(np.zeros((1000, 100)))
+    assert recorder.seen == [[two_threads, two_threads]]
+    with threadpool_limits(1, user_api="blas"):  # never more than allowed
+        assert Recorder(1000).run(np.zeros((1000, 100))).seen == [[1, 1]]
+
+
+def test_set_config_overrides_auto(two_threads):
+    with sklearn_crbm.config_context(blas_threads=two_threads):
+        assert Recorder(200).run(np.zeros((100, 62))).seen == [[two_threads] * 2]
+    with sklearn_crbm.config_context(blas_threads=1):
+        assert Recorder(1000).run(np.zeros((1000, 100))).seen == [[1, 1]]
+    assert sklearn_crbm.get_config()["blas_threads"] == "auto"
+
+
+def test_estimators_limit_their_loops(two_threads, monkeypatch):
+    X, ids = make_oscillations(n_sequences=3, n_frames=40, n_features=4, random_state=0)
+    seen = []
+    import sklearn_crbm._crbm as crbm_module
+
+    original = crbm_module.cd_gradients
+
+    def spy(*args, **kwargs):
+        seen.append(min(blas_threads()))
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(crbm_module, "cd_gradients", spy)
+    with sklearn_crbm.config_context(blas_threads=1):
+        model = ConditionalRBM(5, order=2, n_iter=1, random_state=0)
+        model.fit(X, sequence_ids=ids)
+        StackedCRBM((5, 3), order=2, n_iter=1, random_state=0).fit(X, sequence_ids=ids)
+    assert seen and set(seen) == {1}
+    assert min(blas_threads()) == two_threads
+
+
+def test_nested_and_concurrent_calls_restore_the_count(two_threads):
+    X, ids = make_oscillations(n_sequences=4, n_frames=30, n_features=4, random_state=0)
+    imputer = CRBMImputer(ConditionalRBM(5, order=2, n_iter=2), random_state=0)
+    imputer.fit(X, sequence_ids=ids)
+    X_missing = X.copy()
+    X_missing[10:20, 1] = np.nan
+    with ThreadPoolExecutor(4) as pool:
+        results = list(
+            pool.map(lambda _: imputer.transform(X_missing, sequence_ids=ids), range(8))
+        )
+    for filled in results:
+        np.testing.assert_array_equal(filled, results[0])
+    assert min(blas_threads()) == two_threads
+
+
+@pytest.mark.parametrize("value", [0, -1, 1.5, True, "all", "none"])
+def test_set_config_rejects_bad_thread_counts(value):
+    with pytest.raises(
+        ValueError, match="blas_threads must be 'auto' or a positive int"
+    ):
+        sklearn_crbm.set_config(blas_threads=value)
