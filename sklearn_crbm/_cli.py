@@ -207,12 +207,15 @@ def run_demo(args):
         f"{', '.join(test.sequence_names)}"
     )
 
-    preprocessor = make_motion_preprocessor(train.skeleton)
+    # the paper's encoding: joint rotations from the rest pose, Taylor's roll
+    preprocessor = make_motion_preprocessor(
+        train.skeleton, reference="rest", roll="taylor"
+    )
     Z = preprocessor.fit_transform(train.data, sequence_ids=train.sequence_ids)
     names = preprocessor.get_feature_names_out()
     print(
         f"preprocessed to {Z.shape[1]} dimensions "
-        "(exp maps, body-centred root, z-scores)"
+        "(exp maps, body-centred root, z-scores; the paper's encoding)"
     )
 
     model = _model_from_args(args)
@@ -271,7 +274,7 @@ def _generate_styles(model, Z, train, names, args):
         seeds = random_windows(
             Z,
             sequence_ids=ids,
-            width=model.order,
+            width=max(model.history_length, 1),
             n_windows=3,
             sequences=np.flatnonzero(reference_styles == style),
             random_state=rng,
@@ -411,7 +414,7 @@ def run_sample(args):
     seeds = random_windows(
         Z,
         sequence_ids=train.sequence_ids,
-        width=max(crbm.order, crbm.hidden_order or crbm.order, 1),
+        width=max(crbm.history_length, 1),
         n_windows=args.n_sequences,
         sequences=np.flatnonzero(np.asarray(train.motion) == args.style),
         random_state=args.seed,
