@@ -189,12 +189,26 @@ for row in table:
 ax[1].set_xlabel("held-out log-likelihood (nats/frame)")
 ax[1].set_ylabel("left-leg fill-in MSE (z-scores)")
 ax[1].set_yscale("log")
-ax[1].set_title("higher likelihood, smaller fill-in error")
+ax[1].set_title("fill-in error against the score")
 ax[2].set_xlabel("held-out log-likelihood (nats/frame)")
 ax[2].set_ylabel("generated speed / gait frequency error")
-ax[2].set_title("and generated motion")
+ax[2].set_title("generated motion against the score")
 fig.tight_layout()
 fig.savefig(OUTPUT / "model_selection.png", dpi=90)
+
+# %%
+# What the figure says
+# --------------------
+# Across orders the three measures agree: history lowers the fill-in error
+# and keeps generated motion at the trial's speed and gait frequency, and
+# the log-likelihood rises by tens of nats.  Within an order the agreement is
+# looser.  Here (one fold, 100 epochs, the left leg only) more hidden units
+# fill the leg slightly better while the likelihood prefers fewer; trained
+# for 500 epochs the larger models overfit, and over the grid of
+# ``benchmarks/model_selection.py`` (3 folds, both body parts, 16
+# configurations) the rank correlation between the score and minus the
+# fill-in error is 0.8 among the models with history, and the configuration
+# the search picks fills in within 5% of the best of the grid.
 
 # %%
 # A linear-Gaussian autoregressive baseline on the same scale
