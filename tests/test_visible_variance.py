@@ -10,6 +10,7 @@ compared with what the package computes.
 """
 
 import itertools
+import pickle
 
 import numpy as np
 import pytest
@@ -276,6 +277,17 @@ def test_learned_variances_shrink_to_the_residual_and_stop_at_the_floor():
     assert variance[0] == pytest.approx(1e-4, rel=1e-6)
     # the others near the noise's variance (0.05^2) plus what W leaves
     assert np.all((variance[1:] > 1e-3) & (variance[1:] < 0.01))
+
+
+def test_variances_are_computed_from_the_packed_log_variances():
+    X, ids = make_oscillations(n_sequences=3, n_frames=30, random_state=4)
+    model = ConditionalRBM(8, order=2, visible_variance="learned", n_iter=3)
+    model.fit(X, sequence_ids=ids)
+    packed = model._parameters
+    assert np.shares_memory(packed.log_visible_variance, packed.flat)
+    assert_allclose(model.visible_variance_, np.exp(packed.log_visible_variance))
+    loaded = pickle.loads(pickle.dumps(model))
+    assert_array_equal(loaded.visible_variance_, model.visible_variance_)
 
 
 def test_setting_the_variances_changes_the_model():
