@@ -181,12 +181,16 @@ def test_exact_log_likelihood_of_a_fitted_model_by_enumeration():
     history = X[:-1]
     c, b = dynamic_biases(params, history)
     negative_free = -free_energy(params, X[1:], c, b)
+    # score_samples: log p(x_t | past), frame 0 edge padded (one sequence here)
+    scores = model.score_samples(X[ids == 0])
     for t in range(0, len(history), 7):
         expected = logsumexp(
             [-energy(X[t + 1], h, c[t], b[t], params) for h in HIDDEN]
         ) - log_partition(params, c[t], b[t])
         got = negative_free[t] - log_partition(params, c[t], b[t])
         assert got == pytest.approx(expected, rel=1e-10)
+        if ids[t + 1] == 0 and ids[t] == 0:
+            assert scores[t + 1] == pytest.approx(expected, rel=1e-9)
 
 
 def test_without_hidden_units_the_variance_statistic_is_the_exact_gradient():
