@@ -37,13 +37,11 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 from _splits import cached_model  # noqa: E402
-from generation_styles import (  # noqa: E402
-    draw_seeds,
-    judge,
-    load_cmu_motion,
-)
+from generation_styles import Motion, draw_seeds, judge  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
+from sklearn_crbm.datasets import load_cmu35  # noqa: E402
+from sklearn_crbm.preprocessing import make_motion_preprocessor  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 STYLES = ("walk", "jog")
@@ -134,7 +132,14 @@ def main(argv=None):
     )
     args = parser.parse_args(argv)
 
-    motion, _ = load_cmu_motion(args.data_home)
+    cmu = load_cmu35(args.data_home)
+    # the paper's encoding, in which the tables of the README were measured
+    preprocessor = make_motion_preprocessor(
+        cmu.skeleton, reference="rest", roll="taylor"
+    )
+    motion = Motion(
+        cmu.data, cmu.sequence_ids, cmu.motion, preprocessor, cmu.frame_rate
+    )
     real = real_statistics(motion)
     print(
         "real trials: "
