@@ -122,6 +122,13 @@ def main(argv=None):
         choices=["default", "paper"],
     )
     parser.add_argument("--n-iter", type=int, default=1000)
+    parser.add_argument(
+        "--encoding",
+        default="paper",
+        choices=["paper", "default"],
+        help="joint encoding: the paper's (rest pose, Taylor's roll) or the "
+        "package's default (each joint's mean rotation)",
+    )
     parser.add_argument("--n-per-style", type=int, default=6)
     parser.add_argument(
         "--cache-dir", default=str(Path(tempfile.gettempdir()) / "sklearn_crbm_issue15")
@@ -133,10 +140,10 @@ def main(argv=None):
     args = parser.parse_args(argv)
 
     cmu = load_cmu35(args.data_home)
-    # the paper's encoding, in which the tables of the README were measured
-    preprocessor = make_motion_preprocessor(
-        cmu.skeleton, reference="rest", roll="taylor"
-    )
+    # the paper's encoding, in which the tables of the README were measured,
+    # or the package's default one
+    paper = dict(reference="rest", roll="taylor") if args.encoding == "paper" else {}
+    preprocessor = make_motion_preprocessor(cmu.skeleton, **paper)
     motion = Motion(
         cmu.data, cmu.sequence_ids, cmu.motion, preprocessor, cmu.frame_rate
     )
