@@ -384,7 +384,9 @@ def main(argv=None):
                 args.cache_dir, motion.Z, motion.ids, seed, args.n_iter, params
             )
             rng = np.random.default_rng(seed)
-            seeds, seed_styles = draw_seeds(motion, args.n_per_style, model.order, rng)
+            seeds, seed_styles = draw_seeds(
+                motion, args.n_per_style, model.history_length, rng
+            )
             start = time.perf_counter()
             generated = model.sample(
                 args.n_frames, history=seeds, n_gibbs=args.n_gibbs, random_state=seed

@@ -120,7 +120,7 @@ def main(argv=None):
         )
         rng = np.random.default_rng(seed)
         seeds, seed_styles = styles.draw_seeds(
-            motion, args.n_sequences // 2, model.order, rng
+            motion, args.n_sequences // 2, model.history_length, rng
         )
         for noise in args.noise:
             start = time.perf_counter()

@@ -242,7 +242,7 @@ def true_past_error(imputer, case, n_draws, seed):
     the model's own earlier fills, it measures how much of the error comes
     from fills feeding back through the directed connections (the drift).
     """
-    n_lags = max(imputer.estimator_.order, imputer.estimator_.hidden_order or 0)
+    n_lags = imputer.estimator_.history_length
     Z, mask = case.X, case.missing_mask
     rows = np.flatnonzero(mask.any(axis=1))
     windows = rows[:, None] + np.arange(-n_lags, 1)

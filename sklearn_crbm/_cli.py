@@ -251,12 +251,15 @@ def run_demo(args):
         f"{', '.join(test.sequence_names)}"
     )
 
-    preprocessor = make_motion_preprocessor(train.skeleton)
+    # the paper's encoding: joint rotations from the rest pose, Taylor's roll
+    preprocessor = make_motion_preprocessor(
+        train.skeleton, reference="rest", roll="taylor"
+    )
     Z = preprocessor.fit_transform(train.data, sequence_ids=train.sequence_ids)
     names = preprocessor.get_feature_names_out()
     print(
         f"preprocessed to {Z.shape[1]} dimensions "
-        "(exp maps, body-centred root, z-scores)"
+        "(exp maps, body-centred root, z-scores; the paper's encoding)"
     )
 
     print(f"figures and generated motion go to {args.output} (--output to change)")
@@ -335,7 +338,7 @@ def _generate_styles(model, preprocessor, Z, train, names, args):
         seeds = random_windows(
             Z,
             sequence_ids=ids,
-            width=model.order,
+            width=max(model.history_length, 1),
             n_windows=3,
             sequences=np.flatnonzero(reference_styles == style),
             random_state=rng,
@@ -485,7 +488,7 @@ def _style_windows(pipeline, train, seed):
         style: random_windows(
             Z,
             sequence_ids=train.sequence_ids,
-            width=pipeline[-1].history_length,
+            width=max(pipeline[-1].history_length, 1),
             n_windows=N_STYLE_WINDOWS,
             sequences=np.flatnonzero(styles == style),
             random_state=seed,

@@ -322,7 +322,7 @@ def gait_statistics(
     sequence_ids=None,
     feature_names=None,
     legs=("lfemur", "rfemur", "ltibia", "rtibia"),
-    speed_feature="root_dforward",
+    speed_feature=None,
     frame_rate=30.0,
     last_frames=None,
 ):
@@ -349,8 +349,9 @@ def gait_statistics(
         Bones whose channels give the gait cycle: the CMU names of the hips
         and knees.  Name those of another skeleton here (Taylor's MIT data:
         ``("lhip", "rhip", "lknee", "rknee")``).
-    speed_feature : str, default="root_dforward"
-        The forward-displacement channel.
+    speed_feature : str or int or None, default=None
+        The forward-displacement channel; None takes the one feature named
+        ``"{root}_dforward"``, as :func:`forward_speed` does.
     frame_rate : float, default=30.0
         Frames per second.
     last_frames : int, default=None
