@@ -118,7 +118,9 @@ class ConditionalRBM(BaseCRBM):
         frame ``t``.
     past_to_hidden_ : ndarray of shape (hidden_order, n_components, n_features)
         ``past_to_hidden_[q - 1] @ x[t - q]`` adds to the hidden input of
-        frame ``t``.
+        frame ``t``.  This and the four attributes above are views of one
+        packed parameter buffer; assigning an array of the same shape to
+        one of them changes the model.
     seed_windows_ : ndarray of shape (n_windows, width, n_features)
         ``width = max(order, hidden_order, 1)``. Windows of consecutive
         training frames kept to seed :meth:`sample`.

@@ -322,7 +322,7 @@ def _lag_blocks(matrix, q, n):
     return blocks.transpose(1, 0, 2)
 
 
-def dynamic_biases(params, history, out=None):
+def dynamic_biases(params, history, out=None, static=None):
     """Visible and hidden biases of each frame given its flattened history.
 
     Parameters
@@ -331,6 +331,9 @@ def dynamic_biases(params, history, out=None):
     history : ndarray of shape (n_frames, n_lags * n_features)
     out : ndarray of shape (n_frames, n_features + n_components), default=None
         Where to write both biases side by side (one matrix product).
+    static : ndarray of shape (n_features + n_components,), default=None
+        ``[visible_bias, hidden_bias]`` if the caller keeps it at hand
+        (a loop over frames of a fixed model).
 
     Returns
     -------
@@ -342,7 +345,8 @@ def dynamic_biases(params, history, out=None):
     if out is None:
         out = np.empty((history.shape[0], n + params.n_components), params.dtype)
     # one contiguous add is several times faster than two on strided halves
-    static = np.concatenate((params.visible_bias, params.hidden_bias))
+    if static is None:
+        static = np.concatenate((params.visible_bias, params.hidden_bias))
     if params.n_lags == 0:
         out[...] = static
     else:

@@ -67,6 +67,8 @@ class History:
     def __init__(self, layers, windows):
         self.layers = layers
         self.windows = windows
+        # the static biases of a model that does not change while it runs
+        self._static = [np.concatenate((p.visible_bias, p.hidden_bias)) for p in layers]
 
     @classmethod
     def from_frames(cls, layers, frames):
@@ -108,7 +110,10 @@ class History:
         return History(self.layers, [w[:, sequences] for w in self.windows])
 
     def previous(self, level, sequences):
-        """The last values at ``level`` of ``sequences``: (n_chains, n, n_visible)."""
+        """The last values at ``level`` of ``sequences``: (n_chains, n, n_visible).
+
+        ``sequences`` (here and below) is an index array, or a slice.
+        """
         return self.windows[level][:, sequences, 0]
 
     def biases(self, sequences):
@@ -118,16 +123,16 @@ class History:
         n_visible + n_hidden)``: the visible biases, then the hidden ones.
         """
         biases = []
-        for params, window in zip(self.layers, self.windows, strict=True):
+        for params, window, static in zip(
+            self.layers, self.windows, self._static, strict=True
+        ):
             past = window[:, sequences]
             n_chains, n_rows = past.shape[:2]
             flat = past.reshape(n_chains * n_rows, -1)
             flat = flat[:, : params.n_lags * params.n_features]
-            both = np.empty(
-                (len(flat), params.n_features + params.n_components), params.dtype
-            )
-            dynamic_biases(params, flat, out=both)
-            biases.append(both.reshape(n_chains, n_rows, -1))
+            both = np.empty((n_chains, n_rows, len(static)), params.dtype)
+            dynamic_biases(params, flat, out=both.reshape(len(flat), -1), static=static)
+            biases.append(both)
         return biases
 
     def push(self, values, sequences, biases):
@@ -139,7 +144,7 @@ class History:
         :meth:`biases` for this frame).
         """
         values = list(values)
-        for k in range(len(values), len(self.layers)):
+        for k in range(len(values), len(self.layers)):  # none with one layer
             params = self.layers[k - 1]
             below = values[-1]
             hidden_bias = biases[k - 1][..., params.n_features :]
@@ -304,19 +309,18 @@ def run_online(
 
     level = len(layers) - 1 if scheme == TOP_LAYER else 0
     if observed is None:
-        n_sequences = history.windows[0].shape[1]
-        sequences = np.arange(n_sequences)
-        n_chains = history.windows[0].shape[0]
+        sequences = np.arange(history.windows[0].shape[1])
+        every = slice(None)  # all sequences: basic indexing, no gather
         for step in range(n_steps):
-            biases = history.biases(sequences)
-            start = history.previous(level, sequences)
+            biases = history.biases(every)
+            start = history.previous(level, every)
             if start_jitter:
                 start = start + start_jitter * rng.standard_normal(
                     start.shape[1:], dtype=start.dtype
                 )
             values = draw(start, biases, None)
             yield step, sequences, sequences, values[0]
-            history.push(values, sequences, biases)
+            history.push(values, every, biases)
         return
 
     X, missing, all_sequences = observed.X, observed.missing, observed.sequences

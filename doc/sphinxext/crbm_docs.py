@@ -235,10 +235,23 @@ def unlink_sklearn_roles(app, what, name, obj, options, lines):
         )
 
 
+def skip_fitted_parameters(app, what, name, obj, skip, options):
+    """The class docstring's Attributes section documents the fitted weights.
+
+    ``components_`` and friends are class-level descriptors viewing the
+    packed parameters; listing them as members would repeat each one with
+    the descriptor's own docstring.
+    """
+    from sklearn_crbm._base import FittedParameter
+
+    return True if isinstance(obj, FittedParameter) else None
+
+
 def setup(app):
     # before Sphinx lists the source files and autosummary reads api.rst
     app.connect("config-inited", write_api_reference)
     app.connect("autodoc-process-docstring", unlink_sklearn_roles, priority=600)
+    app.connect("autodoc-skip-member", skip_fitted_parameters)
     app.add_directive("include-if-exists", IncludeIfExists)
     app.add_directive("benchmark-scripts", BenchmarkScripts)
     app.add_directive("command-help", CommandHelp)
