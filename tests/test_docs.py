@@ -88,6 +88,7 @@ def test_docs_build(html_dir):
     for page in [
         "data_model",
         "preprocessing",
+        "own_data",
         "training",
         "generation",
         "filling_in",

@@ -2,6 +2,7 @@
 
 from numbers import Integral, Real
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -37,8 +38,21 @@ def _check_frames(data, name="data"):
     return frames
 
 
+class _Body(NamedTuple):
+    """The bones drawn: the up axis and each drawn bone's parent among them."""
+
+    up_axis: str
+    parent_indices: np.ndarray
+
+
 def _positions(skeleton, data, feature_names):
-    """Joint positions (n_frames, n_bones, 3) through the skeleton's kinematics."""
+    """The body drawn, and its joint positions (n_frames, n_body_bones, 3).
+
+    The body is the skeleton's root and every bone below it, except that a
+    static root with a single child (a rig's dummy bone at the origin above
+    the hips, as ``joint_Root`` in the Bandai Namco files) is left out, and
+    so on down: drawing it would add a line from the origin to the hips.
+    """
     if not all(
         hasattr(skeleton, attribute)
         for attribute in ("forward_kinematics", "parent_indices", "up_axis")
@@ -48,7 +62,24 @@ def _positions(skeleton, data, feature_names):
             f"load_cmu35().skeleton), got {type(skeleton).__name__}."
         )
     frames = _check_frames(data)
-    return skeleton.forward_kinematics(frames, feature_names)
+    positions = skeleton.forward_kinematics(frames, feature_names)
+    parents = np.asarray(skeleton.parent_indices)
+    root = 0
+    while True:
+        children = np.flatnonzero(parents == root)
+        if len(children) != 1 or np.ptp(positions[:, root], axis=0).max() > 0:
+            break
+        root = int(children[0])
+    # parents come before their children: one pass marks the root's subtree
+    in_body = np.zeros(len(parents), dtype=bool)
+    in_body[root] = True
+    for i in range(root + 1, len(parents)):
+        in_body[i] = parents[i] >= 0 and in_body[parents[i]]
+    kept = np.flatnonzero(in_body)
+    new_index = np.full(len(parents), -1)
+    new_index[kept] = np.arange(len(kept))
+    body_parents = np.where(kept == root, -1, new_index[parents[kept]])
+    return _Body(skeleton.up_axis, body_parents), positions[:, kept]
 
 
 def _bone_pairs(skeleton):
@@ -218,16 +249,17 @@ def plot_skeleton(
     """
     check_matplotlib()
     _check_view(view)
-    positions = _positions(skeleton, frame, feature_names)[:1]
+    body, positions = _positions(skeleton, frame, feature_names)
+    positions = positions[:1]
     if view == "3d":
         from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
         ax = get_axes(ax, projection="3d")
-        up = _AXES.index(skeleton.up_axis)
+        up = _AXES.index(body.up_axis)
         ground = [a for a in range(3) if a != up]
         order = [*ground, up]
         points = positions[0][:, order]
-        child, parent = _bone_pairs(skeleton)
+        child, parent = _bone_pairs(body)
         ax.add_collection3d(
             Line3DCollection(
                 np.stack([points[parent], points[child]], axis=1),
@@ -248,7 +280,7 @@ def plot_skeleton(
     from matplotlib.collections import LineCollection
 
     ax = get_axes(ax)
-    segments, points = _side_segments(skeleton, positions, horizontal)
+    segments, points = _side_segments(body, positions, horizontal)
     ax.add_collection(LineCollection(segments[0], colors=color, linewidths=linewidth))
     _frame_limits(ax, points.reshape(-1, 2))
     return ax
@@ -341,12 +373,12 @@ def plot_motion_strip(
         )
     ):
         raise ValueError(f"spacing must be 'auto' or a number >= 0, got {spacing!r}.")
-    positions = _positions(skeleton, data, feature_names)
-    segments, points = _side_segments(skeleton, positions, horizontal)
+    body, positions = _positions(skeleton, data, feature_names)
+    segments, points = _side_segments(body, positions, horizontal)
     drawn = np.arange(0, len(positions), step)
     segments, points = segments[drawn], points[drawn]
     if spacing == "auto":
-        up = _AXES.index(skeleton.up_axis)
+        up = _AXES.index(body.up_axis)
         height = _height(positions, up)
         advance = 0.0
         if len(drawn) > 1:
@@ -444,9 +476,9 @@ def animate_motion(
         raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
     if not frame_rate > 0:
         raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
-    positions = _positions(skeleton, data, feature_names)
-    segments, points = _side_segments(skeleton, positions, horizontal)
-    up = _AXES.index(skeleton.up_axis)
+    body, positions = _positions(skeleton, data, feature_names)
+    segments, points = _side_segments(body, positions, horizontal)
+    up = _AXES.index(body.up_axis)
     height = _height(positions, up)
     ax = get_axes(ax)
     lines = LineCollection(segments[0], colors=color, linewidths=linewidth)

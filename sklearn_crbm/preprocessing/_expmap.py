@@ -217,8 +217,8 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         root = moving_root(self._names_in, X, self.skeleton)
         for i, block in enumerate(self._blocks):
             if block.bone != root:
-                R = euler_to_matrix(X[:, list(block.columns)] * self._scale(), block.axes)
-                references[i] = mean_rotation(R)
+                angles = X[:, list(block.columns)] * self._scale()
+                references[i] = mean_rotation(euler_to_matrix(angles, block.axes))
         return references
 
     def _scale(self):

@@ -175,7 +175,8 @@ def moving_root(feature_names, X, skeleton=None):
             candidates.append(bone)
     for bone in candidates:
         T = X[:, [column[f"{bone}_t{a}"] for a in "xyz"]]
-        if np.any(np.nanmax(T, axis=0, initial=-np.inf) > np.nanmin(T, axis=0, initial=np.inf)):
+        T = T[np.all(np.isfinite(T), axis=1)]
+        if len(T) and np.ptp(T, axis=0).max() > 0:
             return bone
     if candidates:
         return candidates[0]

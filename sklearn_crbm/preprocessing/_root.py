@@ -51,7 +51,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
     bone: ``root`` for CMU ASF/AMC data (so the channels are ``root_pitch``,
     ...), ``Hips`` or ``joint_Root`` for many BVH files (``Hips_pitch``,
     ...).  The root orientation is split as ``R = R_up(heading) @
-    R_left(pitch - pi/2) @ R_forward(roll - pi/2)`` (a yaw-pitch-roll
+    R_left(pi/2 - pitch) @ R_forward(roll - pi/2)`` (a yaw-pitch-roll
     decomposition about the body's forward and left axes, see ``up_axis``):
 
     ``{root}_pitch``
@@ -378,9 +378,10 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             pitch, roll, heading = self._taylor_angles(R)
         else:
             # R = R_z(heading) R_y(pi/2 - pitch) R_x(roll - pi/2), exactly
-            tilt_roll, tilt_pitch, heading = np.moveaxis(matrix_to_euler(R, "xyz"), -1, 0)
-            pitch = np.pi / 2 - tilt_pitch
-            roll = tilt_roll + np.pi / 2
+            angles = matrix_to_euler(R, "xyz")
+            roll = angles[:, 0] + np.pi / 2
+            pitch = np.pi / 2 - angles[:, 1]
+            heading = angles[:, 2]
 
         n = X.shape[0]
         dheading = np.zeros(n)

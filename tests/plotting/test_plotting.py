@@ -183,3 +183,21 @@ def test_facing_view_follows_a_turning_body():
         assert hip_gap < 0.05 * true_gap
     with pytest.raises(ValueError, match="facing"):
         plot_motion_strip(turning.skeleton, data, horizontal="front")
+
+
+def test_a_static_dummy_root_is_not_drawn(data_home):
+    """Bandai Namco files put joint_Root, fixed at the origin, above the moving
+    Hips: the figure is the Hips and the bones below it, placed where they walk."""
+    from sklearn_crbm.datasets import read_bvh
+
+    path = data_home / "external_dev" / "bandai_walk_normal_train"
+    skeleton, data, _, _ = read_bvh(path / "dataset-2_walk_normal_001.bvh")
+    assert skeleton.bone_names[:2] == ["joint_Root", "Hips"]
+    assert np.ptp(skeleton.forward_kinematics(data)[:, 0]) == 0.0
+    ax = plot_skeleton(skeleton, data[0])  # the hips are 5.4 m from the origin
+    segments = np.array(ax.collections[0].get_segments())
+    assert len(segments) == len(skeleton.bones) - 2  # no joint_Root, no link to it
+    # one figure (1.4 m from toes to head joint), no line back to the origin
+    assert np.ptp(segments[..., 0]) < 100.0 and 100.0 < np.ptp(segments[..., 1]) < 200.0
+    strip = plot_motion_strip(skeleton, data[:120], step=8)
+    assert len(strip.collections) >= 15

@@ -270,4 +270,3 @@ def test_mean_reference_measures_bones_from_their_mean_but_not_the_root():
     # every bone's rotation comes back (the thigh as an equivalent triple)
     rotations = walker.skeleton.local_rotations(X)
     assert np.abs(walker.skeleton.local_rotations(back) - rotations).max() < 1e-13
-

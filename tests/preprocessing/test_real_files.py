@@ -60,8 +60,13 @@ def round_trip_errors(skeleton, data, **params):
     assert np.allclose(turn[:, up], np.eye(3)[up], atol=1e-12)
     root_error = _rotation_error_deg(glob, turn @ glob_back).max()
     # the body: the root and the bones below it (not a static bone above it)
-    body = [skeleton.bone_names.index(b) for b in skeleton.descendants(skeleton.bone_names[root])]
-    positions, positions_back = (skeleton.forward_kinematics(x)[:, body] for x in (data, back))
+    body = [
+        skeleton.bone_names.index(b)
+        for b in skeleton.descendants(skeleton.bone_names[root])
+    ]
+    positions, positions_back = (
+        skeleton.forward_kinematics(x)[:, body] for x in (data, back)
+    )
     start, start_back = positions[0, 0], positions_back[0, 0]
     aligned = (positions_back - start_back) @ turn.T + start
     return max(joint_error, root_error), np.abs(aligned - positions).max()
@@ -76,6 +81,22 @@ def test_default_round_trip_is_exact_on_every_file(files):
             errors[name] = round_trip_errors(skeleton, data)
     bad = {n: e for n, e in errors.items() if not (e[0] < 1e-9 and e[1] < 1e-9)}
     assert not bad, f"round trip (degrees, units) not exact: {bad}"
+
+
+def test_z_up_files_round_trip_with_their_up_axis(files):
+    # pybvh's z-up files: the character stands along z (two of them in their
+    # rest pose, bvh_test3 through its root rotation)
+    for name in ["bvh_example.bvh", "standard_skeleton.bvh", "bvh_test3.bvh"]:
+        skeleton, data = files[f"pybvh/{name}"]
+        positions = skeleton.forward_kinematics(data)
+        height = np.ptp(positions[0], axis=0)
+        assert np.argmax(height) == 2 or name == "standard_skeleton.bvh", name
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            rotation_error, position_error = round_trip_errors(
+                skeleton, data, up_axis="z"
+            )
+        assert rotation_error < 1e-9 and position_error < 1e-9, name
 
 
 def test_the_papers_encoding_mirrors_the_backflip_and_says_so(files):

@@ -280,7 +280,9 @@ def test_taylors_roll_matches_the_exact_roll_when_upright_and_warns_otherwise():
     # R = R_y(heading) R_z(lean), z being the forward axis when y is up
     lean = np.tile([0.3, -0.5, 0.0, 1.2], 100)
     heading = np.linspace(-3.0, 3.0, 400)
-    X[:, 3:6] = matrix_to_expmap(euler_to_matrix(np.column_stack([lean, heading]), "zy"))
+    X[:, 3:6] = matrix_to_expmap(
+        euler_to_matrix(np.column_stack([lean, heading]), "zy")
+    )
     E = euler.transform(X)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
