@@ -1,4 +1,4 @@
-"""Shared fixtures: where the real motion-capture data lives.
+"""Shared fixtures: where the real motion-capture data lives, and small subsets.
 
 Tests read the data from ``../shared/data`` beside the repository (or from
 ``$SKLEARN_CRBM_DATA``).  A missing data folder is an error, not a skip: CI
@@ -8,7 +8,11 @@ always has it.
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
+from threadpoolctl import threadpool_limits
+
+from sklearn_crbm.datasets import load_cmu35
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
@@ -31,3 +35,23 @@ def _find_data_home():
 def data_home():
     """Folder holding ``cmu_subject35/``, ``taylor_mhmublv_mit/`` and friends."""
     return _find_data_home()
+
+
+# 6 walks (35_01 ... 35_06) and 3 jogs (35_19 ... 35_21) of the training set:
+# with GroupKFold(3) every fold holds out 2 walks and 1 jog.
+SEARCH_TRIALS = [0, 1, 2, 3, 4, 5, 16, 17, 18]
+
+
+@pytest.fixture(scope="session")
+def cmu_search_trials(data_home):
+    """``(X, sequence_ids, skeleton)``: raw frames of 9 CMU 35 training trials."""
+    bunch = load_cmu35(data_home, subset="train")
+    keep = np.isin(bunch.sequence_ids, SEARCH_TRIALS)
+    return bunch.data[keep], bunch.sequence_ids[keep], bunch.skeleton
+
+
+@pytest.fixture
+def one_blas_thread():
+    """One BLAS thread: on small matrices on a busy machine threads only contend."""
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield

@@ -46,7 +46,7 @@ ROOT_NEEDS_SIX_COLUMNS = (
 
 
 def _tested_estimators():
-    """One small instance of every public estimator (two for the imputer)."""
+    """One small instance of every public estimator, CRBMImputer in three settings."""
     yield ConditionalRBM(n_components=8, n_iter=5, random_state=0)
     yield StackedCRBM((8, 6), order=3, n_iter=5, random_state=0)
     yield CRBMImputer(
@@ -59,6 +59,11 @@ def _tested_estimators():
         n_gibbs=3,
         n_draws=2,
         n_particles=3,
+        random_state=0,
+    )
+    yield CRBMImputer(
+        StackedCRBM((8, 6), order=2, n_iter=3, random_state=0),
+        n_gibbs=3,
         random_state=0,
     )
     yield NearestNeighborImputer()

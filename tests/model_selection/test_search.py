@@ -19,26 +19,15 @@ from threadpoolctl import threadpool_limits
 
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm._stacked import StackedCRBM
-from sklearn_crbm.datasets import load_cmu35
 from sklearn_crbm.preprocessing import make_motion_preprocessor
 
-# 6 walks (35_01 ... 35_06) and 3 jogs (35_19 ... 35_21) of the training set.
-TRIALS = [0, 1, 2, 3, 4, 5, 16, 17, 18]
 CV = GroupKFold(n_splits=3)
-
-
-@pytest.fixture(autouse=True)
-def _one_blas_thread():
-    # Small matrices on a busy machine: BLAS threads only add contention.
-    with threadpool_limits(limits=1, user_api="blas"):
-        yield
+pytestmark = pytest.mark.usefixtures("one_blas_thread")
 
 
 @pytest.fixture(scope="module")
-def cmu(data_home):
-    bunch = load_cmu35(data_home, subset="train")
-    keep = np.isin(bunch.sequence_ids, TRIALS)
-    return bunch.data[keep], bunch.sequence_ids[keep], bunch.skeleton
+def cmu(cmu_search_trials):
+    return cmu_search_trials
 
 
 def _pipeline(skeleton, name, model):
