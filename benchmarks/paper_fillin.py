@@ -26,10 +26,11 @@ upper body 20.52 (nearest neighbour 22.20).
 Variants (``--variants``), each trained once per seed and cached:
 
 ``original``
-    The original code's schedule (REFERENCE.md): CD-1, learning rate 1e-3 for
-    all weights, momentum 0.9 after 5 epochs, weight decay 2e-4, shuffled
-    minibatches of 100 frames, ``--n-iter`` epochs (the paper: 4000); the
-    paper's single-chain fill-in.
+    ``ConditionalRBM.paper_schedule()``, the original code's schedule
+    (REFERENCE.md): CD-1, learning rate 1e-3 for all weights, momentum 0.9
+    after 5 epochs, weight decay 2e-4, shuffled minibatches of 100 frames,
+    clean histories, ``--n-iter`` epochs (the paper: 4000); the paper's
+    single-chain fill-in.
 ``particles``
     The same models; fill-in with 10 particles per draw, resampled before
     every frame by how well each particle's past predicts the frame's
@@ -88,18 +89,13 @@ REPO = Path(__file__).resolve().parents[1]
 PAPER = {("walk", "leg"): (8.78, 11.68), ("walk", "upper"): (20.52, 22.20)}
 PARTS = {"left leg": "leg", "upper body": "upper"}  # short names in the JSON
 
-# The original code's training schedule (REFERENCE.md), 200 hidden, order 3.
-ORIGINAL_MODEL = dict(
-    n_components=200,
-    order=3,
-    learning_rate=1e-3,
-    momentum=0.9,
-    momentum_delay=5,
-    weight_decay=2e-4,
-    cd_steps=1,
-    batch_size=100,
-    batching="shuffled",
-)
+# The paper's training schedule, as ConditionalRBM names it (every parameter
+# spelled out, so later changes of the defaults do not change it).
+ORIGINAL_MODEL = {
+    name: value
+    for name, value in ConditionalRBM.paper_schedule().get_params().items()
+    if name not in ("n_iter", "random_state", "verbose")
+}
 # The training-side fix: noisy histories (ConditionalRBM's ``history_noise``).
 NOISY_MODEL = dict(ORIGINAL_MODEL, history_noise=0.4)
 VARIANTS = {
@@ -107,8 +103,8 @@ VARIANTS = {
     "particles": dict(model=ORIGINAL_MODEL, imputer=dict(n_gibbs=30, n_particles=10)),
     "noisy": dict(model=NOISY_MODEL, imputer=dict(n_gibbs=30, n_particles=1)),
     "robust": dict(model=NOISY_MODEL, imputer=dict(n_gibbs=30, n_particles=10)),
-    # CRBMImputer's default: the noise level that also keeps generated styles
-    # stable (generation_styles.py)
+    # ConditionalRBM's default noise level, which also keeps generated
+    # styles stable (generation_seeds.py)
     "noisy0.8": dict(
         model=dict(ORIGINAL_MODEL, history_noise=0.8),
         imputer=dict(n_gibbs=30, n_particles=1),

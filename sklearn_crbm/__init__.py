@@ -10,7 +10,7 @@ from . import datasets, metrics, model_selection, plotting, preprocessing
 from ._config import config_context, get_config, set_config
 from ._crbm import ConditionalRBM, TrainingDivergedError
 from ._stacked import StackedCRBM
-from .impute import CRBMImputer, NearestNeighborImputer
+from .impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from .preprocessing import (
     ExpMapEncoder,
     RootRelativeEncoder,
@@ -21,6 +21,7 @@ from .preprocessing import (
 __version__ = "0.1.0.dev0"
 
 __all__ = [
+    "AutoregressiveImputer",
     "CRBMImputer",
     "ConditionalRBM",
     "ExpMapEncoder",

@@ -437,7 +437,10 @@ class FittedParameter:
     ``model.components_`` the ``weights`` view of ``model._parameters``
     (:class:`~sklearn_crbm._crbm_math.CRBMParameters`); an unfitted model
     has no such attribute.  Assigning to it writes into the view (same
-    shape only), so the model computes with what was assigned.
+    shape only), so the model computes with what was assigned.  A group that
+    the parameters compute (``visible_variance``, from
+    ``log_visible_variance``) is a new array; assigning to it sets what it
+    is computed from.
     """
 
     def __init__(self, group):
@@ -465,7 +468,12 @@ class FittedParameter:
                 f"{self.name} has shape {view.shape}; got an array of shape "
                 f"{value.shape}. Set the size parameters and refit to change it."
             )
-        view[...] = value
+        params = vars(instance)["_parameters"]
+        computed = getattr(type(params), self.group, None)
+        if isinstance(computed, property) and computed.fset is not None:
+            setattr(params, self.group, value)  # visible_variance, not a view
+        else:
+            view[...] = value
 
 
 def seed_frames(history, n_sequences, *, width, n_features, dtype, seed_windows, rng):

@@ -12,6 +12,7 @@ from sklearn.utils.validation import validate_data
 from ._base import BaseCRBM, FittedParameter
 from ._crbm_math import (
     BINARY,
+    MIN_LOG_VARIANCE,
     CDWorkspace,
     CRBMParameters,
     MomentumUpdate,
@@ -60,9 +61,19 @@ class ConditionalRBM(BaseCRBM):
         Number of past frames feeding the hidden units; ``None`` means
         ``order``.
     visible_type : {"gaussian", "binary"}, default="gaussian"
-        Gaussian visible units with fixed unit variance (standardise the data
-        first, e.g. with :class:`~sklearn_crbm.preprocessing.StandardScaler`),
-        or binary/probability visible units for data in ``[0, 1]``.
+        Gaussian visible units (standardise the data first, e.g. with
+        :class:`~sklearn_crbm.preprocessing.StandardScaler`), or
+        binary/probability visible units for data in ``[0, 1]``.
+    visible_variance : {"unit", "learned"}, default="unit"
+        ``"unit"``: Gaussian visibles of variance 1, as in the paper.
+        ``"learned"``: one variance per channel, trained with the other
+        parameters (Cho, Raiko & Ilin, 2011; see Notes).  Learned variances
+        model the data's density far better (held-out log-likelihood, see
+        ``benchmarks/likelihood_baselines.py``; train them with more
+        reconstruction steps, e.g. ``cd_steps=5``) but fill in and generate
+        worse than unit variances with ``history_noise``
+        (``benchmarks/fillin_baselines.py``).  Gaussian visibles only;
+        variances are kept at or above 1e-4 (standardised data).
     learning_rate : float, default=1e-3
         Step size for every parameter group.
     momentum : float, default=0.9
@@ -81,20 +92,22 @@ class ConditionalRBM(BaseCRBM):
         from each consecutive chunk of the data, so it draws evenly from all
         sequences and holds no neighbouring frames.  ``"shuffled"``: the
         released code's scheme, all trainable frames shuffled each epoch.
-    history_noise : float, default=0.0
+    history_noise : float, default=0.8
         Standard deviation of Gaussian noise added, during training only, to
         the past frames that feed the directed connections (in the units of
         ``X``; the frame being modelled stays clean).  ``0`` is the paper's
-        schedule.  A model trained on clean histories predicts one step
-        ahead well but, when it generates, its own small errors feed back
-        through the directed connections (mostly near-unit-root
-        autoregressive weights) and the generated motion drifts: a walk
-        speeds up into a jog or freezes, differently for every training
-        seed.  Noisy histories teach it to pull a perturbed past back
+        schedule (:meth:`paper_schedule`).  A model trained on clean
+        histories predicts one step ahead well but, when it generates, its
+        own small errors feed back through the directed connections (mostly
+        near-unit-root autoregressive weights) and the generated motion
+        drifts: a walk speeds up into a jog or freezes, differently for
+        every training seed.  Noisy histories teach it to pull a perturbed past back
         towards the data and to carry the style in its hidden units, which
         keeps long generated sequences in their style; 0.8 for standardised
-        motion (see ``benchmarks/generation_styles.py``), at the price of a
-        slightly larger one-step prediction error.
+        motion: every one of five training seeds then generates walks and
+        jogs that keep their style and their leg movement
+        (``benchmarks/generation_seeds.py``), at the price of a larger
+        one-step prediction error.
     n_iter : int, default=200
         Number of epochs (passes over the trainable frames).
     random_state : int, RandomState instance or None, default=None
@@ -121,6 +134,10 @@ class ConditionalRBM(BaseCRBM):
         frame ``t``.  This and the four attributes above are views of one
         packed parameter buffer; assigning an array of the same shape to
         one of them changes the model.
+    visible_variance_ : ndarray of shape (n_features,)
+        Variance ``s^2`` of each Gaussian visible unit given the hidden
+        units: all ones unless ``visible_variance="learned"``.  Computed
+        from the packed ``log s^2``; assigning to it sets that.
     seed_windows_ : ndarray of shape (n_windows, width, n_features)
         ``width = max(order, hidden_order, 1)``. Windows of consecutive
         training frames kept to seed :meth:`sample`.
@@ -151,10 +168,25 @@ class ConditionalRBM(BaseCRBM):
     on.  Memory for ``fit`` is ``O(n_frames * n_features)`` whatever the
     order: no history is ever materialised for the whole data set.
 
+    With learned visible variances the energy of a frame given its history
+    keeps the form of Hinton's practical guide, ``sum_i (v_i - c_hat_i)^2 /
+    (2 s_i^2) - b_hat . h - (v / s) . (W.T h)``: the hidden units see ``v /
+    s`` and the visible mean is ``c_hat + s * (W.T h)``.  Training learns
+    ``log s^2``; the statistics are written out in
+    :func:`sklearn_crbm._crbm_math.cd_gradients` (the visible bias and
+    autoregressive steps are scaled by ``s^2``, the natural gradient of a
+    Gaussian mean).
+
     References
     ----------
     G. W. Taylor, G. E. Hinton and S. Roweis. Modeling Human Motion Using
     Binary Latent Variables. NIPS 19, 2006.
+
+    K. Cho, T. Raiko and A. Ilin. Improved Learning of Gaussian-Bernoulli
+    Restricted Boltzmann Machines. ICANN 2011.
+
+    G. E. Hinton. A Practical Guide to Training Restricted Boltzmann
+    Machines. UTML TR 2010-003, 2010.
 
     Examples
     --------
@@ -174,6 +206,7 @@ class ConditionalRBM(BaseCRBM):
         **BaseCRBM._parameter_constraints,
         "n_components": [Interval(Integral, 1, None, closed="left")],
         "visible_type": [StrOptions({"gaussian", "binary"})],
+        "visible_variance": [StrOptions({"unit", "learned"})],
     }
 
     # Private state that a failed fit must forget with the fitted attributes:
@@ -185,6 +218,7 @@ class ConditionalRBM(BaseCRBM):
     intercept_visible_ = FittedParameter("visible_bias")
     autoregressive_ = FittedParameter("autoregressive")
     past_to_hidden_ = FittedParameter("past_to_hidden")
+    visible_variance_ = FittedParameter("visible_variance")
 
     def __init__(
         self,
@@ -193,6 +227,7 @@ class ConditionalRBM(BaseCRBM):
         order=3,
         hidden_order=None,
         visible_type="gaussian",
+        visible_variance="unit",
         learning_rate=1e-3,
         momentum=0.9,
         momentum_delay=5,
@@ -200,7 +235,7 @@ class ConditionalRBM(BaseCRBM):
         cd_steps=1,
         batch_size=100,
         batching="balanced",
-        history_noise=0.0,
+        history_noise=0.8,
         n_iter=200,
         random_state=None,
         verbose=0,
@@ -209,6 +244,7 @@ class ConditionalRBM(BaseCRBM):
         self.order = order
         self.hidden_order = hidden_order
         self.visible_type = visible_type
+        self.visible_variance = visible_variance
         self.learning_rate = learning_rate
         self.momentum = momentum
         self.momentum_delay = momentum_delay
@@ -220,6 +256,55 @@ class ConditionalRBM(BaseCRBM):
         self.n_iter = n_iter
         self.random_state = random_state
         self.verbose = verbose
+
+    # The training of the paper and its released code (REFERENCE.md).
+    _PAPER_SCHEDULE = dict(
+        n_components=200,
+        order=3,
+        learning_rate=1e-3,
+        momentum=0.9,
+        momentum_delay=5,
+        weight_decay=2e-4,
+        cd_steps=1,
+        batch_size=100,
+        batching="shuffled",
+        history_noise=0.0,
+        visible_variance="unit",
+        n_iter=4000,
+    )
+
+    @classmethod
+    def paper_schedule(cls, **params):
+        """A model with the exact training schedule of the paper.
+
+        Taylor, Hinton & Roweis (2006) and their released code: 200 hidden
+        units, order 3, CD-1 with learning rate 1e-3 for every parameter
+        group, momentum 0.9 after 5 epochs, weight decay 2e-4 on the
+        weights, minibatches of 100 frames shuffled each epoch, clean
+        histories (``history_noise=0``), 4000 epochs.  The defaults differ
+        where measurements showed better models for every training seed
+        (``history_noise``, ``batching``); this keeps the paper's
+        experiments reproducible (``benchmarks/paper_fillin.py``).
+
+        Parameters
+        ----------
+        **params
+            Parameters that replace those of the schedule, e.g.
+            ``n_iter=1000`` or ``random_state=0``.
+
+        Returns
+        -------
+        model : ConditionalRBM
+            Unfitted.
+
+        Examples
+        --------
+        >>> from sklearn_crbm import ConditionalRBM
+        >>> model = ConditionalRBM.paper_schedule(n_iter=1000, random_state=0)
+        >>> model.n_components, model.history_noise, model.batching
+        (200, 0.0, 'shuffled')
+        """
+        return cls(**{**cls._PAPER_SCHEDULE, **params})
 
     # ------------------------------------------------------------------ fit
 
@@ -311,6 +396,11 @@ class ConditionalRBM(BaseCRBM):
     def _check_sequences(self, X, sequence_ids):
         """Validate ids and visible type; return the sequences and trainable frames."""
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
+        if self.visible_type == BINARY and self.visible_variance == "learned":
+            raise ValueError(
+                "visible_variance='learned' needs Gaussian visibles; binary "
+                "visibles have no variance to learn. Use visible_variance='unit'."
+            )
         if self.visible_type == BINARY and (X.min() < 0 or X.max() > 1):
             raise ValueError(
                 "visible_type='binary' needs data in [0, 1] (binary values or "
@@ -338,6 +428,7 @@ class ConditionalRBM(BaseCRBM):
             self.visible_type,
             dtype,
             rng_from(self.random_state_),
+            learned_variance=self.visible_variance == "learned",
         )
         self.n_iter_ = 0
         self._parameters = params
@@ -389,6 +480,12 @@ class ConditionalRBM(BaseCRBM):
                 )
                 squared_error += error
                 update.apply(momentum, self.learning_rate, self.weight_decay)
+                if params.learned_variance:
+                    np.maximum(
+                        params.log_visible_variance,
+                        MIN_LOG_VARIANCE,
+                        out=params.log_visible_variance,
+                    )
             self.n_iter_ += 1
             self.reconstruction_error_ = squared_error / len(frames)
             if not params.is_finite() or not np.isfinite(squared_error):

@@ -17,13 +17,17 @@ hidden).  Both dynamic biases thus come out of one matrix product::
 When ``order != hidden_order`` the blocks of lags a group does not use are
 kept at exactly zero.
 
-With Gaussian visibles of unit variance the energy given the history is
+With Gaussian visibles of standard deviation ``s`` (one per channel) the
+energy given the history is, in the form of Hinton's practical guide,
 
-    E(v, h) = ||v - c_hat||^2 / 2 - b_hat . h - v . (W.T h)
+    E(v, h) = sum_i (v_i - c_hat_i)^2 / (2 s_i^2) - b_hat . h - (v / s) . (W.T h)
 
-so that ``p(h_j = 1 | v) = sigmoid(b_hat_j + W_j . v)`` and ``p(v | h) =
-N(c_hat + W.T h, I)``.  With binary visibles the quadratic term becomes
-``-c_hat . v`` and ``p(v_i = 1 | h) = sigmoid(c_hat_i + (W.T h)_i)``.
+so that ``p(h_j = 1 | v) = sigmoid(b_hat_j + W_j . (v / s))`` and ``p(v | h)
+= N(c_hat + s * (W.T h), diag(s^2))``.  The paper fixes ``s = 1``; with
+learned variances (Cho, Raiko & Ilin 2011) the group ``log_visible_variance``
+holds ``z = log s^2``.  With binary visibles the quadratic term becomes
+``-c_hat . v`` (and ``s = 1``), and ``p(v_i = 1 | h) = sigmoid(c_hat_i +
+(W.T h)_i)``.
 """
 
 import math
@@ -86,6 +90,12 @@ def logistic(activation, out=None):
         np.exp(out, out=out)
     out += 1
     return np.reciprocal(out, out=out)
+
+
+# Learned visible variances are kept at or above 1e-4 (s >= 0.01, in the units
+# of standardised data): a channel that its past predicts almost exactly
+# would otherwise shrink s towards 0 and blow up the hidden input v / s.
+MIN_LOG_VARIANCE = math.log(1e-4)
 
 
 def _small_normal(rng, shape, dtype):
@@ -152,6 +162,13 @@ GROUPS = (
         lambda p, rng: _small_normal(rng, p.visible_bias.shape, p.dtype),
         decayed=False,
     ),
+    # z = log s^2; stays 0 (unit variance) unless learned_variance
+    ParameterGroup(
+        "log_visible_variance",
+        lambda p: (p.n_features,),
+        lambda p, rng: np.zeros(p.n_features, p.dtype),
+        decayed=False,
+    ),
 )
 
 
@@ -174,6 +191,9 @@ class CRBMParameters:
     dtype : dtype
     flat : ndarray of shape (n_parameters,), default=None
         The buffer to view; zeros if None.
+    learned_variance : bool, default=False
+        Whether ``log_visible_variance`` is trained (Gaussian visibles
+        only); if False it is 0 and the math takes the unit-variance path.
     layout : {"C", "F"}, default="C"
         Memory order of the 2-D groups inside ``flat``.  Training works in
         "F", the orientation in which BLAS runs its products fastest;
@@ -198,8 +218,10 @@ class CRBMParameters:
         *,
         flat=None,
         layout="C",
+        learned_variance=False,
     ):
         self.n_features = n_features
+        self.learned_variance = learned_variance
         self.n_components = n_components
         self.order = order
         self.hidden_order = hidden_order
@@ -234,6 +256,22 @@ class CRBMParameters:
         return max(self.order, self.hidden_order)
 
     @property
+    def visible_std(self):
+        """``s``, shape ``(n_features,)``; None for unit variance (the fast path)."""
+        if not self.learned_variance:
+            return None
+        return np.exp(0.5 * self.log_visible_variance)
+
+    @property
+    def visible_variance(self):
+        """``s^2``, shape ``(n_features,)``: ones unless learned (a new array)."""
+        return np.exp(self.log_visible_variance)
+
+    @visible_variance.setter
+    def visible_variance(self, value):
+        self.log_visible_variance[...] = np.log(value)
+
+    @property
     def dtype(self):
         return self.flat.dtype
 
@@ -245,14 +283,32 @@ class CRBMParameters:
 
     @classmethod
     def initialize(
-        cls, n_features, n_components, order, hidden_order, visible_type, dtype, rng
+        cls,
+        n_features,
+        n_components,
+        order,
+        hidden_order,
+        visible_type,
+        dtype,
+        rng,
+        *,
+        learned_variance=False,
     ):
         """The original code's initialisation (REFERENCE.md).
 
         ``W``, ``A``, ``B`` and the visible bias are N(0, 0.01^2); the hidden
-        bias is -1 + N(0, 0.01^2) so that hidden units start mostly off.
+        bias is -1 + N(0, 0.01^2) so that hidden units start mostly off;
+        visible variances start at 1.
         """
-        params = cls(n_features, n_components, order, hidden_order, visible_type, dtype)
+        params = cls(
+            n_features,
+            n_components,
+            order,
+            hidden_order,
+            visible_type,
+            dtype,
+            learned_variance=learned_variance,
+        )
         for group in GROUPS:
             getattr(params, group.name)[...] = group.initial(params, rng)
         return params
@@ -274,6 +330,7 @@ class CRBMParameters:
             self.visible_type,
             self.dtype,
             layout=self.layout if layout is None else layout,
+            learned_variance=self.learned_variance,
         )
 
     @property
@@ -312,6 +369,11 @@ class CRBMParameters:
 
     def __setstate__(self, state):
         vars(self).update(state)
+        if "learned_variance" not in state:  # pickled before variances were a group
+            self.learned_variance = False
+            self.flat = np.concatenate(
+                (self.flat, np.zeros(self.n_features, self.dtype))
+            )
         self._bind()
 
 
@@ -401,21 +463,27 @@ def sequence_hidden_probabilities(params, X, sequences):
 
 
 def hidden_probabilities(params, visible, hidden_bias, out=None):
-    """p(h = 1 | v, history) (paper Eq. 2 with the dynamic hidden bias).
+    """p(h = 1 | v, history) = sigmoid(b_hat + W (v / s)) (paper Eq. 2).
 
     ``out`` (shape ``(n, n_components)``) receives the result if given.
     """
+    std = params.visible_std
+    if std is not None:
+        visible = visible / std
     activation = np.matmul(visible, params.weights.T, out=out)
     activation += hidden_bias
     return logistic(activation, out=activation)
 
 
 def visible_means(params, hidden, visible_bias, out=None):
-    """E[v | h, history] (paper Eq. 3 with the dynamic visible bias).
+    """E[v | h, history] = c_hat + s * (W.T h) (paper Eq. 3).
 
     ``out`` (shape ``(n, n_features)``) receives the result if given.
     """
     mean = np.matmul(hidden, params.weights, out=out)
+    std = params.visible_std
+    if std is not None:
+        mean *= std
     mean += visible_bias
     if params.visible_type == BINARY:
         logistic(mean, out=mean)
@@ -458,6 +526,9 @@ class HiddenSampler:
         # a affine map of the activation a: a / 2 (tanh) or -a (exp)
         self._scale = 0.5 if self._tanh else -1.0
         self.weights = params.weights * 0.5 if self._tanh else params.weights
+        std = params.visible_std
+        if std is not None:  # the hidden input is W (v / s)
+            self.weights = self.weights / std
         self.bias = np.multiply(hidden_bias, self._scale, dtype=params.dtype)
 
     def __call__(self, visible, rng, out, work, *, hidden_noise=0.0, noise=None):
@@ -493,28 +564,36 @@ class HiddenSampler:
 
 
 def sample_visible_states(params, means, rng, out=None):
-    """Draws from p(v | h, history) given its means: N(mean, I) or Bernoulli(mean).
+    """Draws from p(v | h, history) given its means: N(mean, s^2) or Bernoulli(mean).
 
     ``out`` (not ``means`` itself) receives the draws if given.
     """
     if params.visible_type == BINARY:
         return sample_bernoulli(means, rng, out=out)
     noise = rng.standard_normal(means.shape, dtype=means.dtype, out=out)
+    std = params.visible_std
+    if std is not None:
+        noise *= std
     return np.add(means, noise, out=noise)
 
 
 def free_energy(params, visible, visible_bias, hidden_bias):
     """F(v | history), so that p(v | history) is proportional to exp(-F).
 
-    Gaussian: ``||v - c_hat||^2 / 2 - sum_j softplus(b_hat_j + W_j . v)``;
-    binary: ``-c_hat . v - sum_j softplus(...)``.
+    Gaussian: ``sum_i (v_i - c_hat_i)^2 / (2 s_i^2) - sum_j softplus(b_hat_j +
+    W_j . (v / s))``; binary: ``-c_hat . v - sum_j softplus(b_hat_j + W_j . v)``.
     """
-    activation = visible @ params.weights.T
+    std = params.visible_std
+    scaled = visible if std is None else visible / std
+    activation = scaled @ params.weights.T
     activation += hidden_bias
     with np.errstate(under="ignore"):  # softplus(-1e4) = 0 exactly enough
         softplus = np.logaddexp(0, activation).sum(axis=1)
     if params.visible_type == GAUSSIAN:
-        quadratic = 0.5 * np.square(visible - visible_bias).sum(axis=1)
+        residual = visible - visible_bias
+        if std is not None:
+            residual /= std
+        quadratic = 0.5 * np.square(residual).sum(axis=1)
     else:
         quadratic = -(visible * visible_bias).sum(axis=1)
     return quadratic - softplus
@@ -542,6 +621,8 @@ class CDWorkspace:
         self.history = np.empty((n, params.n_lags * d), dtype)
         self.ones = np.ones(n, dtype)
         self.bias_sums = np.empty(d + h, dtype)
+        # s * W.T h of the first reconstruction (learned variances, CD-k > 1)
+        self.first_mean = np.empty((n, d), dtype) if params.learned_variance else None
         self.dynamic_mask = None
         if params.order != params.hidden_order:
             self.dynamic_mask = np.zeros_like(params.dynamic)
@@ -622,6 +703,22 @@ def cd_gradients(
     The visible bias and autoregressive gradients use the residual against
     the dynamic visible bias, which reduces to ``v - v_recon``.
 
+    With learned visible variances (``params.learned_variance``) the weight
+    statistics use ``v / s`` and ``v_recon / s``; the visible bias and
+    autoregressive statistics stay ``v - v_recon``, which is the gradient
+    times ``s^2`` (the natural-gradient scaling of a Gaussian mean, so that
+    their steps do not grow as ``s`` shrinks); and the statistic of ``z_i =
+    log s_i^2`` is, per frame,
+
+        ((v - c_hat)^2 + c_hat * m_last - v * m_first) / (2 s^2) - 1/2
+
+    with ``m = s * (W.T h)`` for the hidden states behind the first and the
+    last reconstruction: the positive term ``-dE/dz`` at the data and the
+    sampled ``h_0``, minus the negative term averaged exactly over ``v_k ~
+    p(v | h_{k-1})`` (Rao-Blackwellised).  With CD-1 it is ``(v - c_hat)(v
+    - v_recon) / (2 s^2) - 1/2``; with no hidden units it vanishes where
+    ``s^2`` is the mean squared residual.
+
     The weight statistics ``h_data.T @ v - h_recon.T @ v_recon`` are one
     matrix product of the stacked ``[h_data; h_recon]`` and ``[v; -v_recon]``;
     those of both directed groups are one product of ``[v - v_recon, h_data -
@@ -670,8 +767,11 @@ def cd_gradients(
         sample_hidden(data, rng, out=positive_states, work=workspace.hidden[:n])
 
     hidden = positive_states
+    learned = params.learned_variance
     for step in range(cd_steps):
         visible_means(params, hidden, visible_bias, out=reconstruction)
+        if learned and step == 0:
+            np.subtract(reconstruction, visible_bias, out=workspace.first_mean[:n])
         if step + 1 < cd_steps:
             with np.errstate(over="ignore", under="ignore", invalid="ignore"):
                 hidden = sample_hidden(
@@ -690,9 +790,23 @@ def cd_gradients(
     np.subtract(positive_states, negative_probabilities, out=delta[:, d:])
     squared_error = float(np.einsum("ij,ij->", visible_delta, visible_delta))
 
-    # the scale goes into the small factors: [v; -v_recon] and delta
-    data *= scale
-    np.multiply(reconstruction, -scale, out=reconstruction)
+    if learned:
+        _log_variance_statistic(
+            params,
+            data,
+            reconstruction,
+            visible_bias,
+            workspace.first_mean[:n],
+            scale,
+            out=out.log_visible_variance,
+        )
+    else:
+        out.log_visible_variance[...] = 0
+    # the scale goes into the small factors: [v; -v_recon] and delta; W's
+    # statistics are those of v / s
+    visible_scale = scale if not learned else scale / params.visible_std
+    data *= visible_scale
+    np.multiply(reconstruction, -visible_scale, out=reconstruction)
     delta *= scale
     np.matmul(stacked_hidden.T, stacked_visible, out=out.weights)
     bias_sums = np.dot(workspace.ones[:n], delta, out=workspace.bias_sums)
@@ -703,6 +817,21 @@ def cd_gradients(
         if workspace.dynamic_mask is not None:
             out.dynamic *= workspace.dynamic_mask
     return out, squared_error
+
+
+def _log_variance_statistic(
+    params, data, reconstruction, visible_bias, first, scale, out
+):
+    """``scale`` times the summed CD statistic of ``z = log s^2`` (see cd_gradients)."""
+    last = reconstruction - visible_bias
+    statistic = np.square(data - visible_bias)
+    statistic += visible_bias * last
+    statistic -= data * first
+    total = statistic.sum(axis=0)
+    total /= 2 * params.visible_variance
+    total -= 0.5 * len(data)
+    np.multiply(total, scale, out=out)
+    return out
 
 
 def gibbs_frames(
@@ -883,7 +1012,7 @@ def observed_log_likelihood(params, prediction, visible, observed_mask):
     Approximates ``log p(v_o | history)``, up to a constant shared by all
     rows, by the likelihood of ``v_o`` given the model's prediction of the
     frame from its history (:func:`mean_field_prediction` or
-    :func:`stacked_prediction`): Gaussian with the model's unit variance
+    :func:`stacked_prediction`): Gaussian with the model's visible variances
     around it, or Bernoulli with it as probabilities.  Particles of an
     on-line filter are weighted by it.
 
@@ -906,4 +1035,7 @@ def observed_log_likelihood(params, prediction, visible, observed_mask):
         terms = np.where(visible > 0.5, np.log(prediction), np.log1p(-prediction))
         return np.where(observed_mask, terms, 0).sum(axis=1)
     residual = np.where(observed_mask, visible - prediction, 0)
+    std = params.visible_std
+    if std is not None:
+        residual /= std
     return -0.5 * np.einsum("ij,ij->i", residual, residual)

@@ -14,6 +14,7 @@ from sklearn.utils.estimator_checks import (
 )
 
 from sklearn_crbm import (
+    AutoregressiveImputer,
     ConditionalRBM,
     CRBMImputer,
     ExpMapEncoder,
@@ -24,6 +25,7 @@ from sklearn_crbm import (
 )
 
 PUBLIC_ESTIMATORS = {
+    AutoregressiveImputer,
     ConditionalRBM,
     StackedCRBM,
     CRBMImputer,
@@ -67,6 +69,7 @@ def _tested_estimators():
         random_state=0,
     )
     yield NearestNeighborImputer()
+    yield AutoregressiveImputer(order=1)
     yield ExpMapEncoder()
     yield ExpMapEncoder(continuous=True)
     yield RootRelativeEncoder()

@@ -48,6 +48,7 @@ def test_layers_are_trained_greedily_on_valid_hidden_probabilities():
         order=2,
         hidden_order=3,
         visible_type="binary",
+        history_noise=0.0,  # the stack's default
         n_iter=5,
         random_state=top.random_state,
     ).fit(hidden[valid], sequence_ids=ids[valid])
@@ -56,7 +57,12 @@ def test_layers_are_trained_greedily_on_valid_hidden_probabilities():
     assert top.seed_windows_.shape[1:] == (3, 6)
     # the bottom layer is a plain ConditionalRBM on the data
     alone = ConditionalRBM(
-        6, order=2, hidden_order=3, n_iter=5, random_state=bottom.random_state
+        6,
+        order=2,
+        hidden_order=3,
+        history_noise=0.0,
+        n_iter=5,
+        random_state=bottom.random_state,
     ).fit(X, sequence_ids=ids)
     assert_allclose(bottom.components_, alone.components_)
 
@@ -259,7 +265,7 @@ def test_history_noise_shrinks_the_directed_weights_and_only_affects_training():
     params = dict(
         n_components=8, order=2, n_iter=100, learning_rate=1e-2, random_state=0
     )
-    clean = ConditionalRBM(**params).fit(X, sequence_ids=ids)
+    clean = ConditionalRBM(history_noise=0.0, **params).fit(X, sequence_ids=ids)
     noisy = ConditionalRBM(history_noise=1.0, **params).fit(X, sequence_ids=ids)
     # the past is less trustworthy, so the autoregressive weights lean on it less
     assert np.linalg.norm(noisy.autoregressive_) < 0.6 * np.linalg.norm(

@@ -26,11 +26,6 @@ from ..utils._sequences import Sequences, check_sequence_ids
 from ..utils._threads import chain_rows, limit_blas_threads
 from ._base import check_imputer_input, complete_runs
 
-# history_noise of the default model: removes the drift of on-line fill-in on
-# CMU 35 (benchmarks/paper_fillin.py, 5 training seeds; 0.4 does too) and keeps
-# generated styles stable (benchmarks/generation_styles.py, where 0.4 does not).
-DEFAULT_HISTORY_NOISE = 0.8
-
 
 class CRBMImputer(
     VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
@@ -56,10 +51,10 @@ class CRBMImputer(
         already is used as it is, without training, when wrapped in
         :class:`sklearn.frozen.FrozenEstimator`:
         ``CRBMImputer(FrozenEstimator(model))``.  ``None`` means
-        ``ConditionalRBM(history_noise=0.8)``: trained on noisy histories so
-        that on-line fills do not drift (see Notes; with the paper's plain
-        schedule the filled upper body of a walk drifts for some training
-        seeds).  Standardise the data first (e.g. with
+        ``ConditionalRBM()``, whose default ``history_noise=0.8`` trains on
+        noisy histories so that on-line fills do not drift (see Notes; with
+        :meth:`ConditionalRBM.paper_schedule` the filled upper body of a
+        walk drifts for some training seeds).  Standardise the data first (e.g. with
         :class:`~sklearn_crbm.preprocessing.StandardScaler`): the visible
         units have unit variance.
     n_gibbs : int, default=30
@@ -259,7 +254,7 @@ class CRBMImputer(
             X = X[rows]
             estimator = self.estimator
             if estimator is None:
-                estimator = ConditionalRBM(history_noise=DEFAULT_HISTORY_NOISE)
+                estimator = ConditionalRBM()
             if isinstance(estimator, FrozenEstimator):
                 self.estimator_ = _check_frozen(estimator.estimator, X.shape[1])
             else:

@@ -1,0 +1,194 @@
+"""Held-out log-likelihood per frame: CRBM against linear-Gaussian AR(3) (issue 15).
+
+Protocol: for each split of ``_splits.py``, the mean over every frame of the
+held-out walk and jog with 3 past frames in its own trial of ``log p(x_t |
+x_{t-3..t-1})`` in nats (``ConditionalRBM.score_samples``: exact
+enumeration of the hidden units when that is cheaper, annealed importance
+sampling otherwise).
+
+- ``learned``: ConditionalRBM(200, order=3, visible_variance="learned",
+  cd_steps=5), one per training seed, trained on the split's training
+  trials but one walk and one jog kept for validation; the number of epochs
+  (a checkpoint among ``--checkpoints``) is the one with the best
+  validation log-likelihood, so the test trials choose nothing;
+- ``default``: the defaults (unit variances) of ``fillin_baselines.py``,
+  1000 epochs, for ``--default-seeds``;
+- baselines: the ridge AR(3) of ``AutoregressiveImputer`` (alpha 1) with
+  unit variance (the CRBM's fixed-variance assumption), per-channel
+  variances, and its full residual covariance, scored exactly on the same
+  frames.
+
+Prints the table and writes JSON to
+``benchmarks/results/likelihood_baselines.json``::
+
+    python benchmarks/likelihood_baselines.py
+    python benchmarks/likelihood_baselines.py --seeds 0 --splits paper
+"""
+
+import os
+
+for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
+
+import argparse  # noqa: E402
+import copy  # noqa: E402
+import json  # noqa: E402
+import tempfile  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+from _splits import (  # noqa: E402
+    SPLITS,
+    Split,
+    cached_model,  # noqa: E402
+)
+from scipy.stats import multivariate_normal  # noqa: E402
+
+from sklearn_crbm import ConditionalRBM  # noqa: E402
+from sklearn_crbm.impute import AutoregressiveImputer  # noqa: E402
+from sklearn_crbm.utils._sequences import check_sequence_ids, frame_history  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+ORDER = 3
+
+
+def ar_log_likelihoods(split):
+    """Mean held-out log p(x_t | past) of the AR(3) with three noise models."""
+    frames = check_sequence_ids(split.test_ids, len(split.X_test)).valid_frames(ORDER)
+    out = {}
+    for name, covariance_type in (
+        ("AR(3), unit variance", "diag"),
+        ("AR(3), per-channel variances", "diag"),
+        ("AR(3), full covariance", "full"),
+    ):
+        ar = AutoregressiveImputer(order=ORDER, covariance_type=covariance_type)
+        ar.fit(split.X_train, sequence_ids=split.train_ids)
+        history = frame_history(split.X_test, frames, ORDER)
+        weights = ar.coef_.transpose(0, 2, 1).reshape(-1, split.X_test.shape[1])
+        mean = history @ weights + ar.intercept_
+        covariance = np.eye(len(ar.intercept_)) if "unit" in name else ar.covariance_
+        residual = split.X_test[frames] - mean
+        out[name] = float(
+            multivariate_normal(np.zeros(len(covariance)), covariance)
+            .logpdf(residual)
+            .mean()
+        )
+    return out, frames
+
+
+def validation_split(split):
+    """The training trials without their last walk and last jog, and those two."""
+    ids = split.train_ids
+    trials = np.unique(ids)
+    lengths = np.array([np.sum(ids == t) for t in trials])
+    # the jogs are the short trials (about 40 frames, walks about 100)
+    jogs, walks = trials[lengths < 70], trials[lengths >= 70]
+    held = np.isin(ids, [walks[-1], jogs[-1]])
+    return (split.X_train[~held], ids[~held]), (split.X_train[held], ids[held])
+
+
+def learned_model(seed):
+    return ConditionalRBM(
+        200, order=ORDER, visible_variance="learned", cd_steps=5, random_state=seed
+    )
+
+
+def chosen_by_validation(split, seed, checkpoints):
+    """Train with checkpoints; the one with the best validation log-likelihood."""
+    (X, ids), (X_val, val_ids) = validation_split(split)
+    X, X_val = X.astype(np.float32), X_val.astype(np.float32)
+    model = learned_model(seed)
+    frames = check_sequence_ids(val_ids, len(X_val)).valid_frames(ORDER)
+    best = (-np.inf, None, None)
+    scores = {}
+    for epoch in range(1, max(checkpoints) + 1):
+        model.partial_fit(X, sequence_ids=ids)
+        if epoch in checkpoints:
+            value = float(
+                model.score_samples(X_val, sequence_ids=val_ids)[frames].mean()
+            )
+            scores[epoch] = value
+            if value > best[0]:
+                best = (value, epoch, copy.deepcopy(model))
+    return best[2], best[1], scores
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--data-home", default=str(REPO.parent / "shared" / "data"))
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
+    parser.add_argument("--default-seeds", type=int, nargs="*", default=[0])
+    parser.add_argument("--splits", nargs="+", default=list(SPLITS), choices=SPLITS)
+    parser.add_argument(
+        "--checkpoints", type=int, nargs="+", default=[10, 25, 50, 100, 200]
+    )
+    parser.add_argument(
+        "--cache-dir", default=str(Path(tempfile.gettempdir()) / "sklearn_crbm_issue15")
+    )
+    parser.add_argument(
+        "--output",
+        default=str(REPO / "benchmarks" / "results" / "likelihood_baselines.json"),
+    )
+    args = parser.parse_args(argv)
+    if not hasattr(ConditionalRBM, "estimate_log_likelihood"):
+        raise SystemExit(
+            "this ConditionalRBM's score_samples is not a normalised log-likelihood "
+            "yet (needs the held-out likelihood of issue 16)"
+        )
+
+    results = {"args": vars(args), "splits": {}}
+    for split_name in args.splits:
+        split = Split(args.data_home, split_name)
+        base, frames = ar_log_likelihoods(split)
+        X_test = split.X_test.astype(np.float32)
+        rows = {}
+        for seed in args.seeds:
+            model, epochs, validation = chosen_by_validation(
+                split, seed, set(args.checkpoints)
+            )
+            test = model.score_samples(X_test, sequence_ids=split.test_ids)
+            rows.setdefault("learned", {})[seed] = dict(
+                log_likelihood=float(test[frames].mean()),
+                epochs=epochs,
+                validation=validation,
+            )
+            print(f"  {split_name} learned seed {seed}: {epochs} epochs", flush=True)
+        for seed in args.default_seeds:
+            model, _ = cached_model(
+                args.cache_dir,
+                ConditionalRBM(200, order=ORDER, n_iter=1000, random_state=seed),
+                split.X_train.astype(np.float32),
+                split.train_ids,
+            )
+            test = model.score_samples(X_test, sequence_ids=split.test_ids)
+            rows.setdefault("default", {})[seed] = dict(
+                log_likelihood=float(test[frames].mean())
+            )
+        results["splits"][split_name] = dict(
+            trials=split.trials, n_frames=len(frames), baselines=base, crbm=rows
+        )
+        report(split_name, split.trials, len(frames), base, rows)
+    output = Path(args.output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    output.write_text(json.dumps(results, indent=2))
+    print(f"\nwrote {output}")
+    return results
+
+
+def report(split_name, trials, n_frames, base, rows):
+    print(
+        f"\nSplit '{split_name}' (walk {trials[0]}, jog {trials[1]} held out, "
+        f"{n_frames} frames): log p(x_t | past), nats per frame"
+    )
+    for name, value in base.items():
+        print(f"| {name:44s} | {value:>9.2f} |")
+    for model, per_seed in rows.items():
+        for seed, row in per_seed.items():
+            label = f"CRBM {model}, seed {seed}" + (
+                f" ({row['epochs']} epochs)" if "epochs" in row else ""
+            )
+            print(f"| {label:44s} | {row['log_likelihood']:>9.2f} |")
+
+
+if __name__ == "__main__":
+    main()
