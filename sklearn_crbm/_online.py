@@ -143,8 +143,9 @@ class History:
         probabilities of the layer below, given ``biases`` (from
         :meth:`biases` for this frame).
         """
-        values = list(values)
-        for k in range(len(values), len(self.layers)):  # none with one layer
+        if len(values) < len(self.layers):
+            values = list(values)
+        for k in range(len(values), len(self.layers)):
             params = self.layers[k - 1]
             below = values[-1]
             hidden_bias = biases[k - 1][..., params.n_features :]
@@ -268,13 +269,7 @@ def run_online(
     def draw(start, biases, clamp):
         """One Gibbs run per (chain, frame) pair; the frame's lowest values."""
         shape = start.shape
-        flat = [b.reshape(-1, b.shape[-1]) for b in biases]
-        visible_biases = [
-            b[:, : p.n_features] for p, b in zip(layers, flat, strict=True)
-        ]
-        hidden_biases = [
-            b[:, p.n_features :] for p, b in zip(layers, flat, strict=True)
-        ]
+        visible_biases, hidden_biases = _split(layers, biases)
         start = start.reshape(-1, shape[-1])
         clamp = None if clamp is None else clamp.reshape(-1, shape[-1])
         if stacked and scheme == WHOLE_STACK:
@@ -384,12 +379,8 @@ def _resample(history, sequences, frames, observed, n_particles, rng):
     n_chains = history.windows[0].shape[0]
     n_groups = n_chains // n_particles
     n_features = frames.shape[1]
-    flat = [b.reshape(-1, b.shape[-1]) for b in history.biases(sequences)]
     prediction = stacked_prediction(
-        layers,
-        [b[:, : p.n_features] for p, b in zip(layers, flat, strict=True)],
-        [b[:, p.n_features :] for p, b in zip(layers, flat, strict=True)],
-        PREDICTION_STEPS,
+        layers, *_split(layers, history.biases(sequences)), PREDICTION_STEPS
     )
     log_weights = observed_log_likelihood(
         layers[0],
@@ -408,3 +399,13 @@ def _resample(history, sequences, frames, observed, n_particles, rng):
     np.minimum(ancestors, n_particles - 1, out=ancestors)
     chains = ancestors + (np.arange(n_groups) * n_particles)[:, None, None]
     history.reorder(chains.reshape(n_chains, len(sequences)), sequences)
+
+
+def _split(layers, biases):
+    """:meth:`History.biases` as two lists of 2-D arrays: visible, hidden."""
+    visible, hidden = [], []
+    for params, both in zip(layers, biases, strict=True):
+        both = both.reshape(-1, both.shape[-1])
+        visible.append(both[:, : params.n_features])
+        hidden.append(both[:, params.n_features :])
+    return visible, hidden

@@ -8,6 +8,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from sklearn_crbm import ConditionalRBM, StackedCRBM
+from sklearn_crbm._base import FittedParameter
 from sklearn_crbm._crbm_math import (
     CRBMParameters,
     dynamic_biases,
@@ -155,13 +156,13 @@ def test_fitted_attributes_view_the_packed_parameters():
     model = ConditionalRBM(5, order=2, n_iter=2, random_state=0).fit(
         X, sequence_ids=IDS
     )
-    for name in (
-        "components_",
-        "intercept_hidden_",
-        "intercept_visible_",
-        "autoregressive_",
-        "past_to_hidden_",
-    ):
+    names = [
+        name
+        for name, attribute in vars(ConditionalRBM).items()
+        if isinstance(attribute, FittedParameter)
+    ]
+    assert {"components_", "autoregressive_", "past_to_hidden_"} <= set(names)
+    for name in names:
         assert np.shares_memory(getattr(model, name), model._parameters.flat)
         loaded = pickle.loads(pickle.dumps(model))
         assert np.shares_memory(getattr(loaded, name), loaded._parameters.flat)
