@@ -281,7 +281,7 @@ def _parse_rows(path, rows, n_channels, n_frames, last_line):
 
 
 # ------------------------------------------------------------------ writing
-def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
+def write_bvh(path, data, skeleton, frame_rate, feature_names=None, *, root=None):
     """Write motion as a BVH file for animation tools.
 
     The file opens in Blender, pybvh, bvhio and bvhtoolbox, and their joint
@@ -298,7 +298,12 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
     A joint with any position channel gets ``Xposition Yposition
     Zposition``, holding its offset as every BVH reader uses it, so an ASF
     root ``position`` is added to the root's translation channels (see
-    :meth:`Skeleton.local_offsets`).
+    :meth:`Skeleton.local_offsets`).  Position channels of a joint other
+    than the root that hold the same offset in every frame (as in the Bandai
+    Namco files) are written as the joint's OFFSET instead: pybvh and
+    bvhtoolbox read position channels on the root only.  A joint other than
+    the root that really moves keeps its channels (Blender and bvhio read
+    them); ``root=`` that joint writes it as the root instead.
 
     For an ASF skeleton every bone becomes a joint at the *start* of the
     bone, and leaf bones get an end site at their end; so the ASF position of
@@ -320,13 +325,21 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
         Frames per second; the file holds ``Frame Time: 1 / frame_rate``.
     feature_names : array-like of str, default=None
         Name of each column of ``data``; default ``skeleton.feature_names``.
+    root : str, default=None
+        Write only this joint and the joints below it, the joint as the
+        ROOT with its global position and rotation in every frame (BVH
+        skeletons only).  For files whose own root is a ground marker above
+        a moving hip joint, such as the Bandai Namco files:
+        ``root="Hips"`` gives a file that every BVH tool reads, with the
+        same positions for every joint it keeps.  None: the skeleton's root.
 
     Raises
     ------
     ValueError
         If a channel of the skeleton is missing, a value is not finite, or
         the skeleton cannot be written as BVH (several roots, translation
-        channels on an ASF bone other than the root).
+        channels on an ASF bone other than the root, ``root=`` not a joint
+        of a BVH skeleton).
 
     Examples
     --------
@@ -352,6 +365,9 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
             "data contain NaN or infinite values; fill them before writing."
         )
     names = skeleton.feature_names if feature_names is None else feature_names
+    if root is not None and root != skeleton.bones[0].name:
+        skeleton, X, names = _rerooted(skeleton, X, names, root)
+        columns = {name: i for i, name in enumerate(names)}
     motion = {
         "X": X,
         "columns": columns,
@@ -359,7 +375,7 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None):
         "offsets": skeleton.local_offsets(X, names),
     }
     try:
-        joints = _bvh_joints(skeleton)
+        joints = _bvh_joints(skeleton, motion["offsets"])
         lines = ["HIERARCHY"]
         _hierarchy_lines(skeleton, joints, skeleton.bones[0].name, 0, lines)
     except RecursionError:
@@ -398,6 +414,43 @@ def _check_writable(skeleton):
             )
 
 
+def _rerooted(skeleton, X, names, root):
+    """``(skeleton, X, names)`` of the joints from ``root`` down, ``root`` a
+    ROOT carrying its global position and rotation (see :func:`write_bvh`)."""
+    if skeleton.convention != "bvh":
+        raise ValueError(
+            "root= needs a BVH skeleton; an ASF skeleton is written from its root."
+        )
+    keep = skeleton.descendants(root)
+    i = skeleton.bone_names.index(root)
+    position = skeleton.forward_kinematics(X, names)[:, i]
+    rotation = skeleton.global_rotations(X, names)[:, i]
+    angles = matrix_to_euler(rotation, "yxz")  # Zrotation Xrotation Yrotation
+    if skeleton.angle_unit == "deg":
+        angles = np.rad2deg(angles)
+    old = skeleton.bone(root)
+    bones = [
+        Bone(root, None, old.direction, old.length, _ROOT_CHANNELS, "yxz"),
+        *(skeleton.bone(name) for name in keep[1:]),
+    ]
+    new = Skeleton(
+        bones,
+        name=skeleton.name,
+        up_axis=skeleton.up_axis,
+        angle_unit=skeleton.angle_unit,
+        convention="bvh",
+    )
+    columns = {name: k for k, name in enumerate(names)}
+    values = np.column_stack(
+        [position, angles[:, [2, 1, 0]]]
+        + [X[:, [columns[name]]] for name in new.feature_names[6:]]
+    )
+    return new, values, new.feature_names
+
+
+_ROOT_CHANNELS = ("tx", "ty", "tz", "rz", "rx", "ry")
+
+
 def _rotation_channels(bone):
     """``(channels, baked)``: the joint's three BVH rotation channels (our short
     names, in file order), and whether they hold a rotation turned into Euler
@@ -409,12 +462,13 @@ def _rotation_channels(bone):
     return own + missing, False
 
 
-def _bvh_joints(skeleton):
+def _bvh_joints(skeleton, offsets):
     """Joints to write, in depth-first order, keyed by bone name.
 
     Each is a dict with the joint ``offset``, its BVH ``channels`` (our short
     names), whether its rotation is ``baked`` into Euler angles, and the
     ``end`` offset of an end site (``None`` when the joint has children).
+    ``offsets`` are the per-frame offsets of :meth:`Skeleton.local_offsets`.
     """
     index = {bone.name: i for i, bone in enumerate(skeleton.bones)}
     acclaim = skeleton.convention == "acclaim"
@@ -434,6 +488,8 @@ def _bvh_joints(skeleton):
         else:
             offset = bone.offset
         moves = any(c in TRANSLATION_CHANNELS for c in bone.channels)
+        if moves and bone.parent is not None and _still(offsets[:, index[bone.name]]):
+            offset, moves = offsets[0, index[bone.name]], False
         rotation, baked = _rotation_channels(bone)
         end = None
         if not children:
@@ -448,6 +504,15 @@ def _bvh_joints(skeleton):
         if bone.name not in joints:
             joints[bone.parent]["end"] = bone.offset
     return _depth_first(skeleton, joints)
+
+
+def _still(offsets):
+    """Whether a joint's per-frame offsets are the same in every frame, up
+    to the last digits a file prints (1e-9 of their size)."""
+    if not len(offsets):
+        return False
+    spread = np.ptp(offsets, axis=0)
+    return bool(np.all(spread <= 1e-9 * np.maximum(1, abs(offsets[0]))))
 
 
 def _depth_first(skeleton, joints):

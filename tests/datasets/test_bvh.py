@@ -218,6 +218,27 @@ def test_mit_to_bvh(tmp_path, data_home):
     )
 
 
+def test_write_bvh_from_another_root(tmp_path, small_bvh):
+    skeleton, data, names, _ = read_bvh(small_bvh)
+    positions = skeleton.forward_kinematics(data)
+    write_bvh(tmp_path / "spine.bvh", data, skeleton, 25.0, root="Spine")
+    spine, data2, names2, _ = read_bvh(tmp_path / "spine.bvh")
+    assert spine.bone_names == ["Spine", "Spine_end"]
+    assert list(names2) == ["Spine_tx", "Spine_ty", "Spine_tz"] + [
+        "Spine_rz",
+        "Spine_rx",
+        "Spine_ry",
+    ]
+    np.testing.assert_allclose(
+        spine.forward_kinematics(data2), positions[:, 1:3], atol=1e-12
+    )
+    with pytest.raises(ValueError, match="no bone 'Tail'"):
+        write_bvh(tmp_path / "x.bvh", data, skeleton, 25.0, root="Tail")
+    walker = make_walker(n_sequences=1, n_frames=2, random_state=0)
+    with pytest.raises(ValueError, match="root= needs a BVH skeleton"):
+        write_bvh(tmp_path / "x.bvh", walker.data, walker.skeleton, 25.0, root="lfemur")
+
+
 def test_write_bvh_checks_its_input(tmp_path, small_bvh):
     skeleton, data, names, _ = read_bvh(small_bvh)
     with pytest.raises(ValueError, match="frame_rate"):

@@ -145,3 +145,30 @@ def test_asf_amc_written_as_bvh_opens_in_an_independent_reader(
     assert_same_positions(
         skeleton, skeleton.forward_kinematics(data), expected, atol=1e-9
     )
+
+
+def test_bandai_hips_written_as_root_opens_everywhere(tmp_path, external_dev):
+    # the Bandai root is a ground marker above a moving Hips joint; tools that
+    # read position channels on the root only need Hips as the ROOT
+    name = "bandai_namco/dataset-2_run_active_001.bvh"
+    skeleton, data, _, frame_rate = read_bvh(external_dev / name)
+    positions = skeleton.forward_kinematics(data[:N_FRAMES])
+    write_bvh(tmp_path / "out.bvh", data[:N_FRAMES], skeleton, frame_rate, root="Hips")
+    mocap = _parse(tmp_path / "out.bvh")
+    assert mocap.get_joints_names()[0] == "Hips"
+    moving = [
+        joint
+        for joint in mocap.get_joints_names()
+        if any("position" in c for c in mocap.joint_channels(joint))
+    ]
+    assert moving == ["Hips"]  # the constant position channels became OFFSETs
+    joints = independent_positions(tmp_path / "out.bvh")
+    assert set(joints) == set(skeleton.bone_names) - {"joint_Root"}
+    for name, expected in joints.items():
+        np.testing.assert_allclose(
+            positions[:, skeleton.bone_names.index(name)],
+            expected,
+            rtol=0,
+            atol=1e-9,
+            err_msg=name,
+        )
