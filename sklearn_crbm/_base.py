@@ -21,6 +21,11 @@ from ._crbm_math import (
     sequence_hidden_probabilities,
     stacked_prediction,
 )
+from ._likelihood import (
+    LogLikelihood,
+    frame_log_likelihood,
+    stack_log_likelihood_bound,
+)
 from ._online import History, run_online
 from .utils._parallel import map_sequence_blocks
 from .utils._persistence import VersionedPickleMixin
@@ -32,8 +37,12 @@ __all__ = ["BaseCRBM", "check_count", "seed_frames"]
 
 # How many windows of training frames ``fit`` keeps to seed ``sample``.
 MAX_SEED_WINDOWS = 500
-# Mean-field iterations of the one-step-ahead prediction behind ``score``.
+# Mean-field iterations of the one-step-ahead prediction (``predict_next``).
 SCORE_MEAN_FIELD_STEPS = 10
+# Annealing of ``score`` for a model without ``ais_steps``/``ais_chains``.
+AIS_STEPS, AIS_CHAINS = 50, 2
+# Draws of the lower layers' hidden units per frame in a stack's bound.
+BOUND_SAMPLES = 10
 # Sequences generated together in one vectorised pass by ``sample``: one
 # frame of 100 sequences costs little more than one of 1, so blocks are large.
 SAMPLE_BLOCK = 256
@@ -55,11 +64,11 @@ class BaseCRBM(
     :class:`ConditionalRBM`); the visible units of layer ``k + 1`` are the
     hidden units of layer ``k``.  This class holds everything that is the
     same for any such stack: input checks, :meth:`transform`,
-    :meth:`predict_next`, :meth:`score`, :meth:`sample` with its seed
-    windows, and the constants.  Subclasses fit, and provide the hooks
-    :attr:`history_length`, ``_layer_parameters`` (the packed parameters of
-    every layer) and, for generation, ``_generation_scheme`` and
-    ``_chain_rng``.
+    :meth:`predict_next`, :meth:`score` and :meth:`score_samples`,
+    :meth:`sample` with its seed windows, and the constants.  Subclasses
+    fit, and provide the hooks :attr:`history_length`, ``_layer_parameters``
+    (the packed parameters of every layer) and, for generation,
+    ``_generation_scheme`` and ``_chain_rng``.
     """
 
     _parameter_constraints: dict = {
@@ -251,20 +260,117 @@ class BaseCRBM(
         return predicted
 
     @limit_blas_threads(frame_rows)
-    def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
-        """Negative one-step-ahead prediction error; higher is better.
+    def score_samples(self, X, *, sequence_ids=None):
+        """Conditional log-likelihood ``log p(x_t | history)`` of every frame, in nats.
 
-        The mean, over every frame with :attr:`history_length` past frames
-        in its own sequence and over features, of the squared difference
-        between the frame and :meth:`predict_next`'s prediction from its
-        history.  It is measured in the units of ``X`` (standardised data:
-        fractions of a standard deviation), so models with any
-        ``n_components``, ``order`` or ``hidden_order``, one layer or a stack,
-        can be compared on held-out sequences, e.g. by
-        ``GridSearchCV(scoring=None)`` (give them the same frames, e.g. by
-        scoring on sequences longer than every ``history_length``).  A model
-        without history (``order=0``) predicts the same frame everywhere and
-        scores like a constant prediction.
+        One layer (:class:`ConditionalRBM`): exact when enumerating the
+        ``2 ** n_components`` hidden configurations costs less than
+        annealing; otherwise estimated by annealed importance sampling with
+        ``ais_steps`` intermediate distributions and ``ais_chains`` chains
+        per frame, seeded by ``random_state`` (see
+        :meth:`ConditionalRBM.estimate_log_likelihood` for the estimate's
+        standard error and a conservative reverse estimate).
+
+        A stack (:class:`StackedCRBM`) generates a frame top-down, so its
+        likelihood sums over the hidden units of every lower layer: with
+        their hidden probabilities as the proposal (as in training), ten
+        draws per frame give the importance-weighted lower bound (Burda,
+        Grosse & Salakhutdinov, 2016; one draw would give the variational
+        bound of Hinton, Osindero & Teh, 2006), whose top term is the top
+        layer's exact or annealed log-likelihood.  Low on average: a stack
+        that scores above a single :class:`ConditionalRBM` is better.
+
+        Frames with fewer than :attr:`history_length` past frames in their
+        sequence use edge padding, as :meth:`transform` does.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            All sequences stacked, each contiguous and in time order.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        log_likelihood : ndarray of shape (n_frames,)
+            Log density (Gaussian visibles) or log probability (binary) of
+            each frame given its history, in the dtype of the model.
+        """
+        X, sequences = self._check_inference_input(X, sequence_ids)
+        return self._log_likelihood(X, sequences).log_likelihood.astype(X.dtype)
+
+    def _ais_settings(self):
+        """Intermediate distributions and chains per frame of the annealing."""
+        return getattr(self, "ais_steps", AIS_STEPS), getattr(
+            self, "ais_chains", AIS_CHAINS
+        )
+
+    def _visible_scale(self):
+        """Standard deviation of the bottom layer's Gaussian visibles (or None)."""
+        bottom = getattr(self, "layers_", [self])[0]
+        variance = getattr(bottom, "visible_variance_", None)
+        return None if variance is None else np.sqrt(variance)
+
+    def _log_likelihood(self, X, sequences, method="auto", reverse=False, rng=None):
+        """:class:`~sklearn_crbm._likelihood.LogLikelihood` of every frame."""
+        layers = self._layer_parameters()
+        n_steps, n_chains = self._ais_settings()
+        rng = rng_from(self.random_state) if rng is None else rng
+        if len(layers) == 1:
+            return frame_log_likelihood(
+                layers[0],
+                self._visible_scale(),
+                X,
+                sequence_dynamic_biases(layers[0], X, sequences),
+                method=method,
+                n_steps=n_steps,
+                n_chains=n_chains,
+                reverse=reverse,
+                rng=rng,
+            )
+        representations = self._representations(X, sequences, layers[:-1])
+        scales = [self._visible_scale()] + [None] * (len(layers) - 1)
+        bounds = []
+        chunks = zip(
+            *(
+                sequence_dynamic_biases(params, values, sequences)
+                for params, values in zip(layers, representations, strict=True)
+            ),
+            strict=True,
+        )
+        for per_layer in chunks:
+            bounds.append(
+                stack_log_likelihood_bound(
+                    list(zip(layers, scales, strict=True)),
+                    X[per_layer[0][0]],
+                    [
+                        (visible_bias, hidden_bias)
+                        for _, visible_bias, hidden_bias in per_layer
+                    ],
+                    n_samples=BOUND_SAMPLES,
+                    rng=rng,
+                    method=method,
+                    n_steps=n_steps,
+                    n_chains=n_chains,
+                )
+            )
+        bound = np.concatenate(bounds)
+        return LogLikelihood(bound, None, np.zeros_like(bound), "bound")
+
+    @limit_blas_threads(frame_rows)
+    def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
+        """Mean held-out log-likelihood per frame, in nats; higher is better.
+
+        The mean of :meth:`score_samples` over every frame with
+        :attr:`history_length` past frames in its own sequence: the
+        conditional log-likelihood ``log p(x_t | x_{t-1}, ..., x_{t-order})``
+        per frame (for a stack, a lower bound on it).  Comparable across
+        ``n_components``, ``order``, ``hidden_order``, visible types and
+        variances, one layer or a stack, on the same frames, so that
+        ``GridSearchCV(scoring=None)`` picks among them (give them the same
+        frames, e.g. by scoring on sequences longer than every
+        ``history_length``).  The one-step prediction error is
+        :func:`~sklearn_crbm.model_selection.make_prediction_scorer`.
 
         Parameters
         ----------
@@ -281,7 +387,7 @@ class BaseCRBM(
         Returns
         -------
         score : float
-            Negative mean squared one-step-ahead prediction error.
+            Mean log-likelihood per frame.
         """
         X, sequences = self._check_inference_input(X, sequence_ids)
         frames = sequences.valid_frames(self.history_length)
@@ -294,9 +400,9 @@ class BaseCRBM(
         weights = None
         if sample_weight is not None:
             weights = _check_sample_weight(sample_weight, X)[frames]
-        predicted = self._predict_frames(X, sequences, frames)
-        errors = np.mean(np.square(X[frames] - predicted), axis=1)
-        return -float(np.average(errors, weights=weights))
+        # every frame, as score_samples draws them: the same random numbers
+        log_likelihood = self._log_likelihood(X, sequences).log_likelihood[frames]
+        return float(np.average(log_likelihood, weights=weights))
 
     # ----------------------------------------------------------- generation
 

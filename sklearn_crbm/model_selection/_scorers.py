@@ -12,9 +12,10 @@ from sklearn.utils.metadata_routing import (
 )
 from sklearn.utils.validation import check_array
 
+from ..utils._sequences import check_sequence_ids
 from ._fillin import check_erasure, erasure_mask
 
-__all__ = ["make_imputation_scorer"]
+__all__ = ["make_imputation_scorer", "make_prediction_scorer"]
 
 
 def make_imputation_scorer(
@@ -143,38 +144,10 @@ def make_imputation_scorer(
     )
 
 
-class _ImputationScorer:
-    """Erase a pattern of channels, fill them with the estimator, score the fill."""
+class _SequenceScorer:
+    """A scorer that requests ``sequence_ids`` through metadata routing."""
 
-    def __init__(
-        self,
-        score_func,
-        *,
-        columns,
-        bones,
-        start,
-        stop,
-        feature_names,
-        missing_values,
-        sign,
-        kwargs,
-    ):
-        if not callable(score_func):
-            raise TypeError(f"score_func must be callable, got {score_func!r}.")
-        check_erasure(columns, bones, start, stop)
-        if bones is not None:
-            bones = [bones] if isinstance(bones, str) else [str(b) for b in bones]
-        self._score_func = score_func
-        self._columns = None if columns is None else np.asarray(columns)
-        self._bones = bones
-        self._start = start
-        self._stop = stop
-        self._feature_names = (
-            None if feature_names is None else np.asarray(feature_names, dtype=object)
-        )
-        self._missing_values = missing_values
-        self._sign = sign
-        self._kwargs = kwargs
+    def __init__(self):
         self._score_request = {"sequence_ids": True}
 
     def get_metadata_routing(self):
@@ -217,6 +190,41 @@ class _ImputationScorer:
         if sequence_ids is not UNCHANGED:
             self._score_request["sequence_ids"] = sequence_ids
         return self
+
+
+class _ImputationScorer(_SequenceScorer):
+    """Erase a pattern of channels, fill them with the estimator, score the fill."""
+
+    def __init__(
+        self,
+        score_func,
+        *,
+        columns,
+        bones,
+        start,
+        stop,
+        feature_names,
+        missing_values,
+        sign,
+        kwargs,
+    ):
+        if not callable(score_func):
+            raise TypeError(f"score_func must be callable, got {score_func!r}.")
+        check_erasure(columns, bones, start, stop)
+        if bones is not None:
+            bones = [bones] if isinstance(bones, str) else [str(b) for b in bones]
+        self._score_func = score_func
+        self._columns = None if columns is None else np.asarray(columns)
+        self._bones = bones
+        self._start = start
+        self._stop = stop
+        self._feature_names = (
+            None if feature_names is None else np.asarray(feature_names, dtype=object)
+        )
+        self._missing_values = missing_values
+        self._sign = sign
+        self._kwargs = kwargs
+        super().__init__()
 
     def __repr__(self):
         parts = [getattr(self._score_func, "__name__", repr(self._score_func))]
@@ -325,6 +333,117 @@ class _ImputationScorer:
                 "features."
             )
         return names
+
+
+def make_prediction_scorer(score_func=mean_squared_error, *, greater_is_better=False):
+    """Make a scorer of the one-step-ahead prediction of held-out frames.
+
+    The scorer compares every frame that has a complete history in its own
+    sequence with the model's deterministic prediction of it from that
+    history alone (``predict_next``)::
+
+        score_func(X[frames], X_pred[frames])
+
+    negated when ``greater_is_better=False`` (the default), so higher is
+    better.  It is what :meth:`ConditionalRBM.score
+    <sklearn_crbm.ConditionalRBM.score>` returned before it became the
+    held-out log-likelihood: pass it as ``scoring=`` to choose a model by
+    how well it predicts the next frame.  It works on a
+    :class:`~sklearn_crbm.ConditionalRBM`, a
+    :class:`~sklearn_crbm.StackedCRBM`, or a Pipeline ending in one (the
+    error is then measured in the space of the model's input, e.g. z-scores).
+
+    Parameters
+    ----------
+    score_func : callable, default=sklearn.metrics.mean_squared_error
+        ``score_func(y_true, y_pred)`` on 2-D arrays of frames.
+    greater_is_better : bool, default=False
+        Whether ``score_func`` is a score (True) or an error (False).
+
+    Returns
+    -------
+    scorer : callable
+        ``scorer(estimator, X, y=None, *, sequence_ids=None)`` returns a
+        float, higher is better; it requests ``sequence_ids`` through
+        metadata routing.
+
+    See Also
+    --------
+    make_imputation_scorer : Score how an imputer fills erased channels.
+
+    Examples
+    --------
+    >>> from sklearn_crbm import ConditionalRBM
+    >>> from sklearn_crbm.datasets import make_oscillations
+    >>> from sklearn_crbm.model_selection import make_prediction_scorer
+    >>> X, ids = make_oscillations(n_sequences=4, n_frames=40, random_state=0)
+    >>> model = ConditionalRBM(8, order=2, n_iter=20, random_state=0)
+    >>> model = model.fit(X, sequence_ids=ids)
+    >>> scorer = make_prediction_scorer()
+    >>> bool(scorer(model, X, sequence_ids=ids) < 0)
+    True
+    """
+    return _PredictionScorer(score_func, sign=1 if greater_is_better else -1)
+
+
+class _PredictionScorer(_SequenceScorer):
+    """Score ``predict_next`` on the frames that have a full history."""
+
+    def __init__(self, score_func, *, sign):
+        if not callable(score_func):
+            raise TypeError(f"score_func must be callable, got {score_func!r}.")
+        self._score_func = score_func
+        self._sign = sign
+        super().__init__()
+
+    def __repr__(self):
+        name = getattr(self._score_func, "__name__", repr(self._score_func))
+        flag = ", greater_is_better=False" if self._sign < 0 else ""
+        return f"make_prediction_scorer({name}{flag})"
+
+    def __call__(self, estimator, X, y=None, *, sequence_ids=None):
+        """Predict every frame from its history and score the prediction.
+
+        Parameters
+        ----------
+        estimator : object
+            A fitted ConditionalRBM, StackedCRBM or Pipeline ending in one.
+        X : array-like of shape (n_frames, n_features)
+            Held-out frames, stacked sequences in time order.
+        y : None
+            Ignored.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        score : float
+            Higher is better.
+        """
+        model = estimator
+        if hasattr(estimator, "steps"):
+            model = estimator[-1]
+            for _, step in estimator.steps[:-1]:
+                if step is not None and step != "passthrough":
+                    X = step.transform(X, **_transform_params(step, sequence_ids))
+        if not hasattr(model, "predict_next"):
+            raise TypeError(
+                f"{type(model).__name__} has no predict_next: the prediction "
+                "scorer needs a ConditionalRBM or StackedCRBM (or a Pipeline "
+                "ending in one)."
+            )
+        X = check_array(X, dtype=np.float64)
+        sequences = check_sequence_ids(sequence_ids, X.shape[0])
+        frames = sequences.valid_frames(model.history_length)
+        if len(frames) == 0:
+            raise ValueError(
+                f"The prediction scorer needs frames with {model.history_length} "
+                "past frames in their own sequence; every sequence given is "
+                "shorter. Pass longer sequences."
+            )
+        predicted = model.predict_next(X, sequence_ids=sequence_ids)
+        score = self._score_func(X[frames], np.asarray(predicted)[frames])
+        return self._sign * float(score)
 
 
 def _routing_enabled():

@@ -19,6 +19,7 @@ __all__ = [
     "frame_history",
     "history_indices",
     "shuffled_batches",
+    "validation_split",
 ]
 
 
@@ -233,6 +234,33 @@ def frame_history(X, frames, n_lags, frame_starts=None, out=None):
     # mode="clip": with mode="raise" numpy buffers ``out`` (several times slower)
     np.take(X, indices.ravel(), axis=0, out=out.reshape(-1, n_features), mode="clip")
     return out
+
+
+def validation_split(sequences, fraction, rng):
+    """Hold out whole sequences: a boolean mask of the validation frames.
+
+    Sequences are taken in a random order until they hold at least
+    ``fraction`` of the frames; at least one is held out and at least one
+    kept.
+
+    Raises
+    ------
+    ValueError
+        If there are fewer than two sequences.
+    """
+    if sequences.n_sequences < 2:
+        raise ValueError(
+            "early_stopping holds out whole sequences for validation, but the "
+            "data is a single sequence; pass sequence_ids marking several "
+            "sequences, or early_stopping=False."
+        )
+    order = rng.permutation(sequences.n_sequences)
+    held = np.cumsum(sequences.lengths[order]) < fraction * sequences.n_frames
+    count = min(max(int(held.sum()) + 1, 1), sequences.n_sequences - 1)
+    mask = np.zeros(sequences.n_frames, dtype=bool)
+    for k in order[:count]:
+        mask[sequences.starts[k] : sequences.stops[k]] = True
+    return mask
 
 
 def _check_batch_size(batch_size):

@@ -1,0 +1,688 @@
+"""Log-likelihood of frames under a conditional RBM: exact or annealed.
+
+Given its history, frame ``t`` of a CRBM is an RBM with dynamic biases
+``c_hat`` (visible) and ``b_hat`` (hidden).  With Gaussian visibles of
+standard deviation ``s`` (one per channel, the square root of
+``visible_variance_``) its energy is (Hinton's practical guide)::
+
+    E(v, h) = sum_i (v_i - c_hat_i)^2 / (2 s_i^2) - b_hat . h - (v / s) . (W.T h)
+
+and with binary visibles ``E(v, h) = -c_hat . v - b_hat . h - v . (W.T h)``.
+Summing out the hiddens gives the free energy ``F(v)`` and
+
+    log p(v | history) = -F(v) - log Z(history).
+
+``log Z`` is a sum over the ``2 ** n_components`` hidden configurations
+(the visibles integrate in closed form for a given ``h``)::
+
+    Gaussian: log Z = logsumexp_h [b_hat . h + (c_hat / s) . u + ||u||^2 / 2]
+                      + sum_i log(sqrt(2 pi) s_i),          u = W.T h
+    binary:   log Z = logsumexp_h [b_hat . h + sum_i softplus(c_hat_i + u_i)]
+
+which :func:`log_partition_exact` enumerates when that is cheap.  Otherwise
+annealed importance sampling (Salakhutdinov & Murray, 2008) estimates it,
+for all frames at once, each with its own chains.  The annealing runs from a
+factorial base distribution at the frame's mean-field fixed point (visible
+mean ``m``, hidden probabilities ``q``; base logits ``a = logit(q)``) to the
+frame's RBM along the intermediate RBMs
+
+    log f_beta(v) = base(v) + beta g(v) + sum_j softplus(a_j + beta (x_j(v) - a_j))
+
+with ``x(v) = b_hat + W (v / s)`` the hidden input, ``base(v)`` the log
+density of the base visibles (Gaussian ``N(m, s^2)`` up to its normaliser,
+or Bernoulli with logits ``logit(m)``) and ``g(v)`` the change of the
+visible term from the base to the model.  ``beta = 0`` is the base (known
+normaliser ``Z_0``), ``beta = 1`` the model.  Each intermediate RBM has
+exact block-Gibbs conditionals, with visible field ``m + beta (c_hat - m) +
+beta s (W.T h)`` (Gaussian mean, or binary logits with ``logit(m)`` for
+``m``).
+
+The forward estimate of ``log Z`` is low on average (Jensen), so the log
+likelihood it gives is high on average.  The reverse estimate (RAISE; Burda,
+Grosse & Salakhutdinov, 2015) starts at the data and anneals back to the
+base; it is an unbiased estimate of the likelihood under the annealing
+process, so its logarithm is low on average: the two bracket the truth when
+the annealing is good, and their gap says how far to trust either.
+"""
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from ._crbm_math import BINARY, logistic
+
+# Hidden configurations summed per block by the exact enumeration.
+_EXACT_BLOCK = 4096
+# The exact path enumerates at most 2 ** this many hidden configurations.
+MAX_EXACT_COMPONENTS = 24
+# Rows (frames x chains) an annealing run keeps in memory at once.
+_AIS_ROWS = 16384
+# Mean-field iterations that find each frame's fixed point (the AIS base).
+_MEAN_FIELD_STEPS = 20
+# Base probabilities are kept this far from 0 and 1 (finite logits).
+_BASE_CLIP = 1e-4
+_LOG_SQRT_2PI = 0.5 * math.log(2 * math.pi)
+# A model without history anneals its one partition function with this many
+# times the per-frame distributions, from this many frames at most.
+SHARED_STEPS = 5
+SHARED_STARTS = 256
+
+
+class FrameRBMs:
+    """The RBMs of a set of frames: shared weights, one pair of biases per frame.
+
+    Parameters
+    ----------
+    params : CRBMParameters
+        Only its weights and visible type are used.
+    visible_bias, hidden_bias : ndarray of shape (n, n_features), (n, n_components)
+        The dynamic biases ``c_hat`` and ``b_hat`` of every frame.
+    scale : ndarray of shape (n_features,), default=None
+        Standard deviation of the Gaussian visibles; ``None`` means ones.
+        Ignored for binary visibles.
+
+    Everything is computed in float64: AIS sums many small log ratios.
+    """
+
+    def __init__(self, params, visible_bias, hidden_bias, scale=None):
+        self.binary = params.visible_type == BINARY
+        self.weights = np.asarray(params.weights, dtype=np.float64)
+        self.visible_bias = np.asarray(visible_bias, dtype=np.float64)
+        self.hidden_bias = np.asarray(hidden_bias, dtype=np.float64)
+        n_features = self.weights.shape[1]
+        if self.binary or scale is None:
+            scale = np.ones(n_features)
+        self.scale = np.asarray(scale, dtype=np.float64)
+
+    @property
+    def n_frames(self):
+        return self.visible_bias.shape[0]
+
+    @property
+    def n_components(self):
+        return self.weights.shape[0]
+
+    @property
+    def n_features(self):
+        return self.weights.shape[1]
+
+    def take(self, rows):
+        """The RBMs of frames ``rows`` (an index array or a slice)."""
+        new = object.__new__(FrameRBMs)
+        new.__dict__.update(self.__dict__)
+        new.visible_bias = self.visible_bias[rows]
+        new.hidden_bias = self.hidden_bias[rows]
+        return new
+
+    def hidden_input(self, visible, hidden_bias=None):
+        """``b_hat + W (v / s)`` for rows of ``visible``."""
+        hidden_bias = self.hidden_bias if hidden_bias is None else hidden_bias
+        return (visible / self.scale) @ self.weights.T + hidden_bias
+
+    def negative_free_energy(self, visible):
+        """``-F(v)`` of every frame's own row of ``visible``."""
+        softplus = np.logaddexp(0, self.hidden_input(visible)).sum(axis=1)
+        if self.binary:
+            return np.einsum("ij,ij->i", visible, self.visible_bias) + softplus
+        residual = (visible - self.visible_bias) / self.scale
+        return softplus - 0.5 * np.einsum("ij,ij->i", residual, residual)
+
+    def gaussian_normaliser(self):
+        """``sum_i log(sqrt(2 pi) s_i)``: the visible integral's constant."""
+        return (
+            0.0
+            if self.binary
+            else float(np.sum(np.log(self.scale)) + (self.n_features * _LOG_SQRT_2PI))
+        )
+
+
+class LogLikelihood(NamedTuple):
+    """Per-frame log-likelihood estimates, in nats.
+
+    Attributes
+    ----------
+    log_likelihood : ndarray of shape (n_frames,)
+        ``log p(x_t | history)``: exact, or from forward AIS.
+    lower : ndarray of shape (n_frames,) or None
+        The reverse-annealing (RAISE) estimate, low on average; equal to
+        ``log_likelihood`` on the exact path; None when not asked for.
+    standard_error : ndarray of shape (n_frames,)
+        Standard error of the forward estimate across chains (zero when
+        exact), by the delta method on the importance weights.
+    method : str
+        ``"exact"`` or ``"ais"``.
+    """
+
+    log_likelihood: np.ndarray
+    lower: np.ndarray | None
+    standard_error: np.ndarray
+    method: str
+
+
+# ------------------------------------------------------------------ exact
+
+
+def hidden_configurations(n_components, start, stop):
+    """Rows ``start`` to ``stop`` of all binary vectors of length ``n_components``."""
+    codes = np.arange(start, stop, dtype=np.int64)[:, None]
+    bits = np.arange(n_components, dtype=np.int64)
+    return ((codes >> bits) & 1).astype(np.float64)
+
+
+def log_partition_exact(rbms):
+    """``log Z`` of every frame's RBM by enumerating its hidden configurations.
+
+    Parameters
+    ----------
+    rbms : FrameRBMs
+
+    Returns
+    -------
+    log_z : ndarray of shape (n_frames,)
+    """
+    n_components = rbms.n_components
+    if n_components > MAX_EXACT_COMPONENTS:
+        raise ValueError(
+            f"Exact enumeration of {n_components} hidden units means 2**"
+            f"{n_components} configurations; it is limited to "
+            f"{MAX_EXACT_COMPONENTS} hidden units. Use method='ais'."
+        )
+    total = 2**n_components
+    block = _EXACT_BLOCK
+    if rbms.binary:  # the softplus term is (frames, block, features)
+        block = max(1, min(block, (1 << 22) // max(1, rbms.n_frames * rbms.n_features)))
+    log_z = np.full(rbms.n_frames, -np.inf)
+    for start in range(0, total, block):
+        hidden = hidden_configurations(n_components, start, min(start + block, total))
+        u = hidden @ rbms.weights  # (configs, n_features)
+        terms = rbms.hidden_bias @ hidden.T
+        if rbms.binary:
+            terms += np.logaddexp(0, rbms.visible_bias[:, None, :] + u).sum(axis=2)
+        else:
+            terms += (rbms.visible_bias / rbms.scale) @ u.T
+            terms += 0.5 * np.einsum("ij,ij->i", u, u)
+        log_z = np.logaddexp(log_z, _logsumexp_rows(terms))
+    return log_z + rbms.gaussian_normaliser()
+
+
+def _logsumexp_rows(values):
+    top = values.max(axis=1)
+    return top + np.log(np.exp(values - top[:, None]).sum(axis=1))
+
+
+def exact_is_cheaper(n_components, n_features, n_steps, n_chains):
+    """Whether enumerating the hiddens costs less than annealing one frame."""
+    if n_components > MAX_EXACT_COMPONENTS:
+        return False
+    exact = 2.0**n_components * (n_components + 2 * n_features)
+    annealed = n_steps * n_chains * (2 * n_components * n_features + 4 * n_components)
+    return exact <= annealed
+
+
+# -------------------------------------------------------------- annealing
+
+
+def mean_field_base(rbms, start=None, n_steps=_MEAN_FIELD_STEPS):
+    """The factorial base of every frame at its mean-field fixed point.
+
+    The iteration starts from the visible bias ``c_hat``, or from ``start``
+    (visible values, one row per frame) when given.
+
+    Returns
+    -------
+    visible_base : ndarray of shape (n_frames, n_features)
+        Gaussian: the base mean ``m``; binary: the base logits.
+    hidden_logits : ndarray of shape (n_frames, n_components)
+    """
+    field = rbms.visible_bias.copy()
+    if start is not None:
+        field = _logit(start) if rbms.binary else np.array(start, dtype=np.float64)
+    hidden = None
+    for _ in range(n_steps):
+        visible = logistic(field) if rbms.binary else field
+        hidden = logistic(rbms.hidden_input(visible))
+        field = rbms.visible_bias + rbms.scale * (hidden @ rbms.weights)
+    if rbms.binary:
+        field = _logit(logistic(field))
+    return field, _logit(hidden)
+
+
+def _logit(probability):
+    p = np.clip(probability, _BASE_CLIP, 1 - _BASE_CLIP)
+    return np.log(p) - np.log1p(-p)
+
+
+class _Annealing:
+    """The path from the factorial base to the RBM of every row (one per chain).
+
+    The chains run in float32 (numpy's float32 ``exp`` and ``log1p`` are
+    several times faster than float64's); each step's change of the log
+    weight is a sum of small elementwise differences, accumulated in
+    float64.  ``d = x(v) - a`` is the hidden input's distance from the base
+    logits; the intermediate RBM at ``beta`` has hidden logits ``a + beta
+    d`` and, from the base to the model, its visible term changes by
+    ``beta g(v)`` with ``g`` linear in ``v`` for either visible type
+    (Gaussian: ``(c_hat - m) . (v - (c_hat + m) / 2) / s^2``; binary:
+    ``(c_hat - logit(m)) . v``).
+    """
+
+    dtype = np.float32
+
+    def __init__(self, rbms, n_chains, start=None):
+        visible_base, hidden_logits = mean_field_base(rbms, start)
+        rows = np.repeat(np.arange(rbms.n_frames), n_chains)
+        self.binary = rbms.binary
+        self.n_rows = len(rows)
+        self.log_base_normaliser = np.logaddexp(0, hidden_logits).sum(axis=1)[rows]
+        if rbms.binary:
+            self.log_base_normaliser += np.logaddexp(0, visible_base).sum(axis=1)[rows]
+        else:
+            self.log_base_normaliser += rbms.gaussian_normaliser()
+        scale = rbms.scale
+        shift = rbms.visible_bias - visible_base  # c_hat - m
+        gradient = shift if rbms.binary else shift / scale**2
+        offset = 0.0
+        if not rbms.binary:
+            middle = 0.5 * (rbms.visible_bias + visible_base)
+            offset = np.einsum("ij,ij->i", gradient, middle)[rows]
+        self.change_offset = offset
+
+        def rows_of(array):
+            return np.ascontiguousarray(array[rows], dtype=self.dtype)
+
+        self.scale = scale.astype(self.dtype)
+        self.visible_base = rows_of(visible_base)
+        self.shift = rows_of(shift)
+        self.gradient = rows_of(gradient)
+        self.hidden_logits = rows_of(hidden_logits)
+        self.input_offset = rows_of(rbms.hidden_bias - hidden_logits)  # b_hat - a
+        self.input_weights = np.ascontiguousarray((rbms.weights / scale).T, self.dtype)
+        self.field_weights = np.ascontiguousarray(rbms.weights * scale, self.dtype)
+        n_hidden = rbms.n_components
+        self.difference = np.empty((self.n_rows, n_hidden), self.dtype)
+        self.logits = np.empty_like(self.difference)
+        self.previous = np.empty_like(self.difference)
+        self.work = np.empty_like(self.difference)
+
+    def sample_base(self, rng):
+        if self.binary:
+            return _bernoulli(logistic(self.visible_base.copy()), rng)
+        noise = rng.standard_normal(self.visible_base.shape, dtype=self.dtype)
+        noise *= self.scale
+        return np.add(self.visible_base, noise, out=noise)
+
+    def step(self, visible, beta, previous_beta):
+        """``log f_beta(v) - log f_previous(v)`` of every row (float64).
+
+        Leaves the hidden logits at both temperatures in :attr:`logits`
+        (``beta``) and :attr:`previous` (``previous_beta``).
+        """
+        difference = np.matmul(visible, self.input_weights, out=self.difference)
+        difference += self.input_offset
+        logits = np.multiply(difference, beta, out=self.logits)
+        logits += self.hidden_logits
+        previous = np.multiply(difference, previous_beta - beta, out=self.previous)
+        previous += logits
+        hidden = _softplus(logits, self.work)
+        hidden -= _softplus(previous, self.difference)
+        change = np.einsum("ij,ij->i", visible, self.gradient, dtype=np.float64)
+        change -= self.change_offset
+        change *= beta - previous_beta
+        change += hidden.sum(axis=1, dtype=np.float64)
+        return change
+
+    def gibbs(self, beta, logits, rng):
+        """A block-Gibbs step at ``beta`` from hidden logits ``a + beta d(v)``."""
+        hidden = _bernoulli(logistic(logits, out=self.work), rng)
+        field = np.matmul(hidden, self.field_weights)
+        field += self.shift
+        field *= beta
+        field += self.visible_base
+        if self.binary:
+            return _bernoulli(logistic(field, out=field), rng)
+        noise = rng.standard_normal(field.shape, dtype=self.dtype)
+        noise *= self.scale
+        field += noise
+        return field
+
+
+def _softplus(x, out):
+    """``log(1 + exp(x))`` elementwise into ``out`` (not ``x``)."""
+    np.abs(x, out=out)
+    np.negative(out, out=out)
+    np.exp(out, out=out)
+    np.log1p(out, out=out)
+    out += np.maximum(x, 0)
+    return out
+
+
+def _bernoulli(probability, rng):
+    draws = rng.random(probability.shape, dtype=probability.dtype)
+    return np.less(draws, probability).astype(probability.dtype)
+
+
+def annealing_schedule(n_steps):
+    """``n_steps + 1`` inverse temperatures from 0 to 1, denser near 1.
+
+    The RBM's hidden units switch on and off most sharply near ``beta =
+    1``; half the steps go to ``[0, 0.75]`` (linear), half to ``[0.75, 1]``.
+    """
+    if n_steps < 2:
+        return np.linspace(0.0, 1.0, n_steps + 1)
+    first = n_steps // 2
+    return np.concatenate(
+        (
+            np.linspace(0.0, 0.75, first + 1)[:-1],
+            np.linspace(0.75, 1.0, n_steps - first + 1),
+        )
+    )
+
+
+def log_partition_ais(rbms, n_steps, n_chains, rng):
+    """Forward AIS estimate of every frame's ``log Z``, with its standard error.
+
+    Parameters
+    ----------
+    rbms : FrameRBMs
+    n_steps : int
+        Intermediate distributions (transitions) per chain.
+    n_chains : int
+        Independent chains per frame.
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    log_z : ndarray of shape (n_frames,)
+        ``log`` of the mean importance weight times ``Z_0``.
+    standard_error : ndarray of shape (n_frames,)
+        Delta-method standard error of ``log_z`` across chains.
+    """
+    log_z = np.empty(rbms.n_frames)
+    error = np.empty(rbms.n_frames)
+    for rows in _row_blocks(rbms.n_frames, n_chains):
+        log_weights = _forward_log_weights(rbms.take(rows), n_steps, n_chains, rng)
+        log_z[rows], error[rows] = _log_mean_exp(log_weights)
+    return log_z, error
+
+
+def shared_log_partition_ais(rbms, starts, n_steps, n_chains, rng):
+    """AIS estimate of the one ``log Z`` of an RBM without history.
+
+    Every frame of a model without history has the same RBM, often with
+    several modes (walking and jogging, say).  Chains run from the
+    mean-field fixed points reached from each of ``starts`` (frames), so
+    that they begin in different modes; each chain's weight, times its own
+    base's ``Z_0``, is an unbiased estimate of ``Z``, and all are pooled.
+
+    Parameters
+    ----------
+    rbms : FrameRBMs
+        One frame's RBM (the first row is used).
+    starts : ndarray of shape (n_starts, n_features)
+        Visible values the mean-field iterations start from.
+
+    Returns
+    -------
+    log_z : float
+    standard_error : float
+    """
+    rbms = rbms.take(np.zeros(len(starts), dtype=np.intp))
+    log_weights = [
+        _forward_log_weights(rbms.take(rows), n_steps, n_chains, rng, starts[rows])
+        for rows in _row_blocks(len(starts), n_chains)
+    ]
+    log_z, error = _log_mean_exp(np.concatenate(log_weights).reshape(1, -1))
+    return float(log_z[0]), float(error[0])
+
+
+def _forward_log_weights(rbms, n_steps, n_chains, rng, start=None):
+    path = _Annealing(rbms, n_chains, start)
+    betas = annealing_schedule(n_steps)
+    visible = path.sample_base(rng)
+    log_weight = path.log_base_normaliser.copy()
+    for k in range(1, len(betas)):
+        log_weight += path.step(visible, betas[k], betas[k - 1])
+        if k < len(betas) - 1:
+            visible = path.gibbs(betas[k], path.logits, rng)
+    return log_weight.reshape(rbms.n_frames, n_chains)
+
+
+def log_likelihood_raise(rbms, visible, n_steps, n_chains, rng):
+    """Reverse-annealing (RAISE) estimate of ``log p(v)``, low on average.
+
+    Each chain starts at the frame ``v``, takes a Gibbs step at every
+    inverse temperature from 1 down to the first above 0, and collects
+    ``log f_{k-1} - log f_k`` at every state it reaches; with ``-F(v) -
+    log Z_0`` this is the log of an unbiased estimate of the likelihood of
+    ``v`` under the annealing process that the forward chains follow.
+
+    Returns
+    -------
+    log_likelihood : ndarray of shape (n_frames,)
+    """
+    result = np.empty(rbms.n_frames)
+    for rows in _row_blocks(rbms.n_frames, n_chains):
+        result[rows] = _reverse_log_likelihood(
+            rbms.take(rows), visible[rows], n_steps, n_chains, rng
+        )
+    return result
+
+
+def _reverse_log_likelihood(rbms, visible, n_steps, n_chains, rng):
+    path = _Annealing(rbms, n_chains)
+    betas = annealing_schedule(n_steps)
+    start = np.repeat(rbms.negative_free_energy(visible), n_chains)
+    log_weight = start - path.log_base_normaliser
+    state = np.repeat(visible, n_chains, axis=0).astype(path.dtype)
+    path.step(state, betas[-1], betas[-2])  # the hidden logits at beta = 1
+    logits = path.logits
+    for k in range(len(betas) - 1, 0, -1):
+        state = path.gibbs(betas[k], logits, rng)
+        log_weight -= path.step(state, betas[k], betas[k - 1])
+        logits = path.previous
+    return _log_mean_exp(log_weight.reshape(rbms.n_frames, n_chains))[0]
+
+
+def _row_blocks(n_frames, n_chains):
+    per_block = max(1, _AIS_ROWS // n_chains)
+    for lo in range(0, n_frames, per_block):
+        yield slice(lo, min(lo + per_block, n_frames))
+
+
+def _log_mean_exp(log_weights):
+    """``log mean exp`` over axis 1, and its delta-method standard error."""
+    top = log_weights.max(axis=1, keepdims=True)
+    weights = np.exp(log_weights - top)
+    mean = weights.mean(axis=1)
+    n = log_weights.shape[1]
+    spread = weights.std(axis=1, ddof=1) if n > 1 else np.zeros(len(mean))
+    return top[:, 0] + np.log(mean), spread / (math.sqrt(n) * mean)
+
+
+# ----------------------------------------------------------------- public
+
+
+def log_partition(rbms, *, method, n_steps, n_chains, rng):
+    """``log Z`` of every frame, its standard error and the method used.
+
+    ``method="auto"`` enumerates the hiddens when that costs less than
+    annealing with ``n_steps`` and ``n_chains`` (:func:`exact_is_cheaper`).
+    """
+    if method == "auto":
+        cheaper = exact_is_cheaper(
+            rbms.n_components, rbms.n_features, n_steps, n_chains
+        )
+        method = "exact" if cheaper else "ais"
+    if method == "exact":
+        return log_partition_exact(rbms), np.zeros(rbms.n_frames), "exact"
+    return (*log_partition_ais(rbms, n_steps, n_chains, rng), "ais")
+
+
+def _shared_log_partition(rbms, frames, method, n_steps, n_chains, rng):
+    """``log Z``, its standard error and the method, for a model without history."""
+    starts = frames[
+        np.unique(np.linspace(0, len(frames) - 1, SHARED_STARTS).round()).astype(
+            np.intp
+        )
+    ]
+    n_steps *= SHARED_STEPS
+    n_chains_total = n_chains * len(starts)
+    one = rbms.take(slice(0, 1))
+    if method == "auto":
+        cheaper = exact_is_cheaper(
+            rbms.n_components, rbms.n_features, n_steps, n_chains_total
+        )
+        method = "exact" if cheaper else "ais"
+    if method == "exact":
+        return log_partition_exact(one)[0], 0.0, "exact"
+    return (*shared_log_partition_ais(one, starts, n_steps, n_chains, rng), "ais")
+
+
+def frame_log_likelihood(
+    params,
+    scale,
+    visible,
+    chunks,
+    *,
+    method="auto",
+    n_steps=50,
+    n_chains=2,
+    reverse=False,
+    rng=None,
+):
+    """``log p(v_t | history)`` of frames, chunk by chunk, exact or by AIS.
+
+    Parameters
+    ----------
+    params : CRBMParameters
+    scale : ndarray of shape (n_features,) or None
+        Standard deviation of the Gaussian visibles (None: ones).
+    visible : ndarray of shape (n_frames, n_features)
+        The frames, indexed by the rows of ``chunks``.
+    chunks : iterable of (rows, visible_bias, hidden_bias)
+        The frames' dynamic biases, as an estimator's
+        ``_iter_dynamic_biases`` yields them.
+    method : {"auto", "exact", "ais"}, default="auto"
+    n_steps, n_chains : int, default=50, 2
+        AIS intermediate distributions and chains per frame.  A model
+        without history (``n_lags == 0``) has one partition function for
+        every frame; it is annealed once (:func:`shared_log_partition_ais`)
+        with ``SHARED_STEPS * n_steps`` distributions and ``n_chains``
+        chains from each of up to ``SHARED_STARTS`` frames.
+    reverse : bool, default=False
+        Also run reverse annealing (RAISE), a conservative estimate.
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    LogLikelihood
+    """
+    rng = np.random.default_rng() if rng is None else rng
+    with np.errstate(under="ignore"):  # exp of very negative numbers is 0
+        parts = _chunk_log_likelihoods(
+            params, scale, visible, chunks, method, n_steps, n_chains, reverse, rng
+        )
+    return LogLikelihood(
+        np.concatenate([p[0] for p in parts]),
+        np.concatenate([p[1] for p in parts]) if reverse else None,
+        np.concatenate([p[2] for p in parts]),
+        parts[0][3] if parts else "exact",
+    )
+
+
+def _chunk_log_likelihoods(
+    params, scale, visible, chunks, method, n_steps, n_chains, reverse, rng
+):
+    shared = None
+    parts = []
+    for rows, visible_bias, hidden_bias in chunks:
+        rbms = FrameRBMs(params, visible_bias, hidden_bias, scale)
+        if params.n_lags == 0:
+            if shared is None:
+                shared = _shared_log_partition(
+                    rbms, visible[rows], method, n_steps, n_chains, rng
+                )
+            log_z, error, used = shared
+        else:
+            log_z, error, used = log_partition(
+                rbms, method=method, n_steps=n_steps, n_chains=n_chains, rng=rng
+            )
+        frames = visible[rows].astype(np.float64)
+        log_likelihood = rbms.negative_free_energy(frames) - log_z
+        lower = None
+        if reverse:
+            lower = log_likelihood
+            if used == "ais":
+                lower = log_likelihood_raise(rbms, frames, n_steps, n_chains, rng)
+        parts.append((log_likelihood, lower, np.broadcast_to(error, len(rows)), used))
+    return parts
+
+
+# ------------------------------------------------------------------ stacks
+
+
+def stack_log_likelihood_bound(layers, visible, biases, *, n_samples, rng, **top):
+    """A lower bound on ``log p(v_t | history)`` under a stack of CRBMs.
+
+    The stack generates a frame top-down: the top CRBM gives the units of
+    the layer below it, each lower layer's conditional ``p_l(h_{l-1} |
+    h_l)`` the layer below, down to the frame.  With every lower layer's
+    posterior ``q_l(h_l | h_{l-1})`` (its hidden probabilities, as in
+    training) as the proposal, ``n_samples`` draws ``h_1, ..., h_{L-1}``
+    give the importance-weighted bound (Burda, Grosse & Salakhutdinov,
+    2016; with one sample the variational bound of Hinton et al., 2006)::
+
+        log mean_s exp(sum_l [log p_l(h_{l-1} | h_l) - log q_l(h_l | h_{l-1})]
+                       + log p_top(h_{L-1} | history))
+
+    low on average by Jensen's inequality, whose top term is the top CRBM's
+    exact or annealed log-likelihood.
+
+    Parameters
+    ----------
+    layers : list of (CRBMParameters, scale)
+        Bottom first; ``scale`` is the bottom layer's visible standard
+        deviation (or None).
+    visible : ndarray of shape (n_frames, n_features)
+    biases : list of (visible_bias, hidden_bias)
+        Every layer's dynamic biases for these frames, from its own history.
+    n_samples : int
+    rng : numpy.random.Generator
+    **top
+        ``method``, ``n_steps`` and ``n_chains`` for the top layer's
+        :func:`log_partition`.
+
+    Returns
+    -------
+    bound : ndarray of shape (n_frames,)
+    """
+    n_frames = len(visible)
+    rows = np.repeat(np.arange(n_frames), n_samples)
+    state = visible[rows].astype(np.float64)
+    log_weight = np.zeros(len(rows))
+    with np.errstate(under="ignore"):
+        for (params, scale), (visible_bias, hidden_bias) in zip(
+            layers[:-1], biases[:-1], strict=True
+        ):
+            rbms = FrameRBMs(params, visible_bias[rows], hidden_bias[rows], scale)
+            logits = rbms.hidden_input(state)
+            hidden = _bernoulli(logistic(logits.copy()), rng)
+            log_weight -= np.sum(hidden * logits - np.logaddexp(0, logits), axis=1)
+            log_weight += _log_visible_given_hidden(rbms, state, hidden)
+            state = hidden
+        params, scale = layers[-1]
+        top_rbms = FrameRBMs(params, *biases[-1], scale)
+        log_z, _, _ = log_partition(top_rbms, rng=rng, **top)
+        log_weight += top_rbms.take(rows).negative_free_energy(state) - log_z[rows]
+    return _log_mean_exp(log_weight.reshape(n_frames, n_samples))[0]
+
+
+def _log_visible_given_hidden(rbms, visible, hidden):
+    """``log p(v | h)`` per row: ``N(c_hat + s W.T h, s^2)`` or Bernoulli."""
+    field = hidden @ rbms.weights
+    if rbms.binary:
+        field += rbms.visible_bias
+        return np.sum(visible * field - np.logaddexp(0, field), axis=1)
+    residual = (visible - rbms.visible_bias) / rbms.scale - field
+    return -0.5 * np.einsum("ij,ij->i", residual, residual) - rbms.gaussian_normaliser()
