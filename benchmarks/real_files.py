@@ -243,14 +243,25 @@ def round_trip(skeleton, data):
         return f"{type(exc).__name__}: {str(exc).splitlines()[0][:100]}"
     local, local_back = skeleton.local_rotations(data), skeleton.local_rotations(back)
     glob, glob_back = skeleton.global_rotations(data), skeleton.global_rotations(back)
-    # the start pose of the root is not kept: align the first frames' roots
-    turn = glob[0, 0] @ glob_back[0, 0].T
     positions = skeleton.forward_kinematics(data)
     positions_back = skeleton.forward_kinematics(back)
-    aligned = (positions_back - positions_back[0, 0]) @ turn.T + positions[0, 0]
+    # the start pose of the encoder's root (Bandai: Hips, below a static
+    # marker) is not kept: align it, and the bones below it, at frame 0
+    root_name = pre.named_steps["root"].root_
+    i = skeleton.bone_names.index(root_name)
+    below = [skeleton.bone_names.index(n) for n in skeleton.descendants(root_name)]
+    turn = glob[0, i] @ glob_back[0, i].T
+    aligned = positions_back.copy()
+    aligned[:, below] = (positions_back[:, below] - positions_back[0, i]) @ turn.T
+    aligned[:, below] += positions[0, i]
+    others = [k for k in range(len(skeleton.bones)) if k != i]
     rotation_error = max(
-        float(np.max(rotation_angle_deg(local[:, 1:], local_back[:, 1:]), initial=0)),
-        float(np.max(rotation_angle_deg(glob[:, 0], turn @ glob_back[:, 0]))),
+        float(
+            np.max(
+                rotation_angle_deg(local[:, others], local_back[:, others]), initial=0
+            )
+        ),
+        float(np.max(rotation_angle_deg(glob[:, i], turn @ glob_back[:, i]))),
     )
     warned = sorted({str(w.message).splitlines()[0][:80] for w in caught})
     return back, rotation_error, float(np.max(np.abs(aligned - positions))), warned
@@ -403,6 +414,9 @@ def main():
     parser.add_argument("--output", default=None)
     args = parser.parse_args()
     folders = [Path(args.data_home) / "external_dev", *map(Path, args.folders)]
+    missing = [str(folder) for folder in folders if not folder.is_dir()]
+    if missing:
+        parser.error(f"no such folder: {missing} (see --data-home)")
     amcparser = load_amcparser(args.amcparser)
     rows, expected = [], {}
     start = time.perf_counter()

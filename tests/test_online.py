@@ -164,6 +164,8 @@ def test_fitted_attributes_view_the_packed_parameters():
     ]
     assert {"components_", "autoregressive_", "past_to_hidden_"} <= set(names)
     for name in names:
+        if name == "visible_variance_":  # exp of the packed log-variances
+            continue
         assert np.shares_memory(getattr(model, name), model._parameters.flat)
         loaded = pickle.loads(pickle.dumps(model))
         assert np.shares_memory(getattr(loaded, name), loaded._parameters.flat)

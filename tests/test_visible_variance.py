@@ -10,6 +10,7 @@ compared with what the package computes.
 """
 
 import itertools
+import pickle
 
 import numpy as np
 import pytest
@@ -180,12 +181,16 @@ def test_exact_log_likelihood_of_a_fitted_model_by_enumeration():
     history = X[:-1]
     c, b = dynamic_biases(params, history)
     negative_free = -free_energy(params, X[1:], c, b)
+    # score_samples: log p(x_t | past), frame 0 edge padded (one sequence here)
+    scores = model.score_samples(X[ids == 0])
     for t in range(0, len(history), 7):
         expected = logsumexp(
             [-energy(X[t + 1], h, c[t], b[t], params) for h in HIDDEN]
         ) - log_partition(params, c[t], b[t])
         got = negative_free[t] - log_partition(params, c[t], b[t])
         assert got == pytest.approx(expected, rel=1e-10)
+        if ids[t + 1] == 0 and ids[t] == 0:
+            assert scores[t + 1] == pytest.approx(expected, rel=1e-9)
 
 
 def test_without_hidden_units_the_variance_statistic_is_the_exact_gradient():
@@ -276,6 +281,17 @@ def test_learned_variances_shrink_to_the_residual_and_stop_at_the_floor():
     assert variance[0] == pytest.approx(1e-4, rel=1e-6)
     # the others near the noise's variance (0.05^2) plus what W leaves
     assert np.all((variance[1:] > 1e-3) & (variance[1:] < 0.01))
+
+
+def test_variances_are_computed_from_the_packed_log_variances():
+    X, ids = make_oscillations(n_sequences=3, n_frames=30, random_state=4)
+    model = ConditionalRBM(8, order=2, visible_variance="learned", n_iter=3)
+    model.fit(X, sequence_ids=ids)
+    packed = model._parameters
+    assert np.shares_memory(packed.log_visible_variance, packed.flat)
+    assert_allclose(model.visible_variance_, np.exp(packed.log_visible_variance))
+    loaded = pickle.loads(pickle.dumps(model))
+    assert_array_equal(loaded.visible_variance_, model.visible_variance_)
 
 
 def test_setting_the_variances_changes_the_model():
