@@ -6,7 +6,9 @@ walking and jogging, draw figures).
 """
 
 import argparse
+import shutil
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -30,6 +32,14 @@ from .preprocessing import make_motion_preprocessor
 from .utils import random_windows
 
 __all__ = ["main"]
+
+# The demo writes here unless --output says otherwise: never into the current
+# folder, which in a checkout is the repository.
+DEMO_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_demo"
+# Stick figures in the demo's strip of a generated sequence.
+STRIP_FIGURES = 30
+# Seed windows of each style that ``fit`` saves with the model, for ``sample``.
+N_STYLE_WINDOWS = 50
 
 PAPER_FILLIN = {
     ("walk", "left leg"): (8.78, 11.68),
@@ -64,7 +74,7 @@ def _parser():
         help="the paper's demo on CMU 35: train, fill in, generate, draw",
         description="Train a CRBM on CMU subject 35, print the fill-in table "
         "against nearest neighbour, generate walking and jogging, and write "
-        "figures. The defaults take a few minutes on 2 cores; --full runs the "
+        "figures. The defaults take about a minute on 2 cores; --full runs the "
         "paper's 4000 epochs and 100 fill-in repeats.",
     )
     _add_data_home(demo)
@@ -72,34 +82,34 @@ def _parser():
     demo.add_argument(
         "--output",
         type=Path,
-        default=Path("crbm_demo"),
-        help="folder for figures and generated motion (default: %(default)s)",
+        default=DEMO_OUTPUT,
+        help="folder for the figures and the generated motion (AMC files)",
     )
     demo.add_argument(
         "--n-repeats",
         type=int,
         default=20,
-        help="single-draw fills averaged per case (paper: 100)",
+        help="single-draw fills averaged per case (the paper: 100)",
     )
     demo.add_argument(
         "--n-particles",
         type=int,
         default=1,
-        help="weighted particles per fill-in chain (default: %(default)s, the "
-        "original scheme)",
+        help="weighted particles per fill-in chain (1: the original scheme)",
     )
     demo.add_argument(
-        "--n-frames",
-        type=int,
-        default=300,
-        help="frames generated per sequence (default: %(default)s)",
+        "--n-frames", type=int, default=300, help="frames generated per sequence"
     )
     demo.add_argument(
         "--full",
         action="store_true",
         help="the paper's full size: 4000 epochs, 100 fill-in repeats",
     )
-    demo.add_argument("--no-figures", action="store_true", help="skip the figures")
+    demo.add_argument(
+        "--no-figures",
+        action="store_true",
+        help="skip the figures (the AMC files are still written)",
+    )
     demo.set_defaults(run=run_demo)
 
     fetch = commands.add_parser(
@@ -113,32 +123,64 @@ def _parser():
     )
     _add_data_home(fit)
     _add_model_options(fit, n_iter=1000)
-    fit.add_argument("--output", type=Path, default=Path("crbm_cmu35.joblib"))
+    fit.add_argument(
+        "--output",
+        type=Path,
+        default=Path("crbm_cmu35.joblib"),
+        help="file the fitted pipeline (preprocessing + CRBM) is saved to",
+    )
     fit.set_defaults(run=run_fit)
 
     sample = commands.add_parser(
-        "sample", help="generate motion from a saved model and write AMC files"
+        "sample",
+        help="generate motion from a saved model and write AMC files",
+        description="Generate motion from a model saved by the fit command and "
+        "write one AMC file per sequence. The seed frames are saved with the "
+        "model: no data is read.",
     )
-    _add_data_home(sample)
     sample.add_argument("model", type=Path, help="a file written by the fit command")
     sample.add_argument(
         "--style",
-        choices=("walk", "jog"),
+        choices=("walk", "jog", "any"),
         default="walk",
-        help="seed the generation with frames of this style",
+        help="seed each sequence with real frames of this style ('any': the "
+        "model's own seed windows, from every training trial)",
     )
-    sample.add_argument("--n-frames", type=int, default=300)
-    sample.add_argument("--n-sequences", type=int, default=1)
-    sample.add_argument("--hidden-noise", type=float, default=0.0)
-    sample.add_argument("--seed", type=int, default=0)
+    sample.add_argument(
+        "--n-frames", type=int, default=300, help="frames generated per sequence"
+    )
+    sample.add_argument(
+        "--n-sequences", type=int, default=1, help="sequences generated"
+    )
+    sample.add_argument(
+        "--hidden-noise",
+        type=float,
+        default=0.0,
+        help="noise on the hidden biases (the paper's style transitions: about 1)",
+    )
+    sample.add_argument(
+        "--seed", type=int, default=0, help="random seed of the seeds and sampling"
+    )
     sample.add_argument(
         "--output",
         type=Path,
         default=Path("generated"),
-        help="prefix of the AMC files written",
+        help="prefix of the AMC files written (PREFIX_0.amc, PREFIX_1.amc, ...)",
     )
     sample.set_defaults(run=run_sample)
+    for command in (demo, fetch, fit, sample):
+        command.formatter_class = _HelpFormatter
     return parser
+
+
+class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Ends every option's help with its default, where it has one to show."""
+
+    def _get_help_string(self, action):
+        no_default = action.default is None or action.default is False
+        if no_default or "default" in (action.help or ""):
+            return action.help
+        return super()._get_help_string(action)
 
 
 def _add_data_home(parser):
@@ -151,23 +193,25 @@ def _add_data_home(parser):
 
 
 def _add_model_options(parser, n_iter):
-    parser.add_argument("--n-components", type=int, default=200)
-    parser.add_argument("--order", type=int, default=3)
+    parser.add_argument(
+        "--n-components", type=int, default=200, help="hidden units of the CRBM"
+    )
+    parser.add_argument(
+        "--order", type=int, default=3, help="past frames each frame depends on"
+    )
     parser.add_argument(
         "--history-noise",
         type=float,
         default=0.8,
-        help="noise on the history during training (default: %(default)s; 0 is "
-        "the paper's schedule, whose fill-ins and generated styles drift for "
-        "some seeds)",
+        help="noise on the history during training (0 is the paper's schedule, "
+        "whose fill-ins and generated styles drift for some seeds)",
     )
     parser.add_argument(
-        "--n-iter",
-        type=int,
-        default=n_iter,
-        help="training epochs (default: %(default)s; the paper: 4000)",
+        "--n-iter", type=int, default=n_iter, help="training epochs (the paper: 4000)"
     )
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--seed", type=int, default=0, help="random seed of training and sampling"
+    )
 
 
 def _model_from_args(args):
@@ -218,6 +262,7 @@ def run_demo(args):
         "(exp maps, body-centred root, z-scores; the paper's encoding)"
     )
 
+    print(f"figures and generated motion go to {args.output} (--output to change)")
     model = _model_from_args(args)
     print(f"\ntraining {model!r}")
     imputer = CRBMImputer(model, n_particles=args.n_particles, random_state=args.seed)
@@ -226,18 +271,31 @@ def run_demo(args):
 
     cases = make_fillin_cases(test, preprocessor)
     table = _fillin_table(imputer, Z, cases, args.n_repeats, args.seed)
-    generated = _generate_styles(model, Z, train, names, args)
+    generated = _generate_styles(model, preprocessor, Z, train, names, args)
+    args.output.mkdir(parents=True, exist_ok=True)
+    written = _write_generated(args.output, preprocessor, train, generated)
     if not args.no_figures:
-        _draw(args.output, model, preprocessor, train, cases, table, generated)
-    print(f"\ndone in {time.perf_counter() - start:.0f} s")
+        written += _draw(
+            args.output, model, preprocessor, train, cases, table, generated
+        )
+    print(f"\nwrote to {args.output}: " + ", ".join(p.name for p in written))
+    print(f"done in {time.perf_counter() - start:.0f} s")
     return 0
 
 
 def _fillin_table(imputer, Z_train, cases, n_repeats, seed):
     nearest = NearestNeighborImputer().fit(Z_train)
     print(
-        f"\nfilling in (the paper's error, summed over the erased frames; "
-        f"CRBM: mean of {n_repeats} single draws)"
+        "\nfilling in: a body part of each held-out trial is erased from "
+        "half-way to the end and filled in on-line, frame by frame\n"
+        "  CRBM, NN     the paper's error (per erased frame, the mean squared "
+        "error over the erased channels in standard deviations, summed over "
+        "the erased frames; lower is better) of the CRBM (mean of "
+        f"{n_repeats} single draws) and of nearest neighbour\n"
+        "  ratio        CRBM / NN: below 1, the CRBM fills in better\n"
+        "  CRBM°, NN°   root mean squared error of the erased joint angles, "
+        "in degrees\n"
+        "  paper        the paper's CRBM / NN errors (walk only)"
     )
     print(
         f"{'sequence':<14}{'erased':<12}{'CRBM':>8}{'NN':>8}{'ratio':>7}"
@@ -259,13 +317,19 @@ def _fillin_table(imputer, Z_train, cases, n_repeats, seed):
     return table
 
 
-def _generate_styles(model, Z, train, names, args):
+def _generate_styles(model, preprocessor, Z, train, names, args):
     """Seed with walk frames and with jog frames; classify what comes out."""
     ids = train.sequence_ids
     reference = gait_statistics(Z, sequence_ids=ids, feature_names=names)
     reference_styles = np.asarray(train.motion)
     print(
-        f"\ngenerating {args.n_frames} frames per sequence, 3 sequences per seed style"
+        f"\ngenerating {args.n_frames} frames per sequence, 3 sequences seeded "
+        "with real walking and 3 with jogging; each is classified by the nearest "
+        "training style\n"
+        "  speed        mean forward displacement of the body per frame, in "
+        "the skeleton's length units (CMU: 1/0.45 inch)\n"
+        "  step Hz      gait frequency (steps of one leg per second, at 30 "
+        "frames/s)"
     )
     print(f"{'seeded with':<12}{'speed':>8}{'step Hz':>9}   classified as")
     generated = {}
@@ -283,17 +347,40 @@ def _generate_styles(model, Z, train, names, args):
         gen_ids = np.repeat(np.arange(3), args.n_frames)
         stats = gait_statistics(frames, sequence_ids=gen_ids, feature_names=names)
         labels = nearest_style(stats, reference, reference_styles)
-        for row, label in zip(stats, labels, strict=True):
-            print(f"{style:<12}{row[0]:8.3f}{row[1]:9.2f}   {label}")
+        speeds = _speed_in_length_units(preprocessor, frames, stats[:, 0])
+        for row, speed, label in zip(stats, speeds, labels, strict=True):
+            print(f"{style:<12}{speed:8.3f}{row[1]:9.2f}   {label}")
         generated[style] = (frames, gen_ids)
+    speeds = _speed_in_length_units(preprocessor, Z, reference[:, 0])
     for style in ("walk", "jog"):
-        real = reference[reference_styles == style]
+        real = reference_styles == style
         print(
-            f"{'real ' + style:<12}{real[:, 0].mean():8.3f}"
-            f"{np.nanmean(real[:, 1]):9.2f}"
+            f"{'real ' + style:<12}{speeds[real].mean():8.3f}"
+            f"{np.nanmean(reference[real, 1]):9.2f}"
             "   (training mean)"
         )
     return generated
+
+
+def _speed_in_length_units(preprocessor, Z, speed):
+    """Speeds measured on standardised frames, in the encoder's units again."""
+    scaler = preprocessor[-1]
+    names = list(preprocessor[:-1].get_feature_names_out())
+    column = names.index("root_dforward")
+    return speed * scaler.scale_[column] + scaler.mean_[column]
+
+
+def _write_generated(output, preprocessor, train, generated):
+    """The first generated sequence of each style, as an AMC file."""
+    written = []
+    for style, (frames, gen_ids) in generated.items():
+        raw = preprocessor.inverse_transform(frames, sequence_ids=gen_ids)
+        path = output / f"generated_{style}.amc"
+        write_amc(
+            path, raw[gen_ids == 0], train.skeleton, feature_names=train.feature_names
+        )
+        written.append(path)
+    return written
 
 
 def _draw(output, model, preprocessor, train, cases, table, generated):
@@ -313,25 +400,21 @@ def _draw(output, model, preprocessor, train, cases, table, generated):
             "\nmatplotlib is not installed: no figures "
             "(pip install 'sklearn_crbm[plot]')"
         )
-        return
-    output.mkdir(parents=True, exist_ok=True)
+        return []
     written = []
     for style, (frames, gen_ids) in generated.items():
         raw = preprocessor.inverse_transform(frames, sequence_ids=gen_ids)
-        first = raw[gen_ids == 0][:120]
-        fig, ax = plt.subplots(figsize=(12, 3))
+        first = raw[gen_ids == 0]
+        step = -(-len(first) // STRIP_FIGURES)
+        fig, ax = plt.subplots(figsize=(14, 3))
         plot_motion_strip(
-            train.skeleton, first, feature_names=train.feature_names, step=6, ax=ax
+            train.skeleton, first, feature_names=train.feature_names, step=step, ax=ax
         )
-        ax.set_title(f"generated from a {style} seed (every 6th frame)")
+        ax.set_title(
+            f"generated from a {style} seed: all {len(first)} frames, one "
+            f"figure every {step} frames"
+        )
         written.append(_save(fig, output / f"generated_{style}.png"))
-        write_amc(
-            output / f"generated_{style}.amc",
-            raw[gen_ids == 0],
-            train.skeleton,
-            feature_names=train.feature_names,
-        )
-        written.append(output / f"generated_{style}.amc")
     case, result = cases["walk", "left leg"], table["walk", "left leg"]
     names = preprocessor.get_feature_names_out()
     axes = plot_filled_channels(
@@ -354,7 +437,7 @@ def _draw(output, model, preprocessor, train, cases, table, generated):
     )
     ax.set_title("hidden units on a walk then a jog")
     written.append(_save(fig, output / "hidden_activations.png"))
-    print("\nwrote " + ", ".join(str(p) for p in written))
+    return written
 
 
 def _save(fig, path):
@@ -368,9 +451,15 @@ def _save(fig, path):
 # ---------------------------------------------------------- other commands
 def run_fetch(args):
     home = get_data_home(args.data_home)
+    existed = home.exists()
     print(f"downloading into {home}")
-    fetch_cmu35(home)
-    fetch_mit_walk(home)
+    try:
+        fetch_cmu35(home)
+        fetch_mit_walk(home)
+    except BaseException:
+        if not existed:  # everything in it is this command's partial download
+            shutil.rmtree(home, ignore_errors=True)
+        raise
     print("done")
     return 0
 
@@ -382,9 +471,30 @@ def run_fit(args):
         + [("crbm", _model_from_args(args))]
     )
     pipeline.fit(train.data, sequence_ids=train.sequence_ids)
+    pipeline.style_windows_ = _style_windows(pipeline, train, args.seed)
     joblib.dump(pipeline, args.output)
     print(f"saved the fitted pipeline to {args.output}")
     return 0
+
+
+def _style_windows(pipeline, train, seed):
+    """Windows of real walking and jogging (preprocessed) that seed ``sample``.
+
+    Saved with the model, so that ``sample`` needs no data on disk.
+    """
+    Z = pipeline[:-1].transform(train.data, sequence_ids=train.sequence_ids)
+    styles = np.asarray(train.motion)
+    return {
+        style: random_windows(
+            Z,
+            sequence_ids=train.sequence_ids,
+            width=max(pipeline[-1].history_length, 1),
+            n_windows=N_STYLE_WINDOWS,
+            sequences=np.flatnonzero(styles == style),
+            random_state=seed,
+        )
+        for style in ("walk", "jog")
+    }
 
 
 def _load_model(path):
@@ -409,28 +519,34 @@ def _load_model(path):
 def run_sample(args):
     pipeline = _load_model(args.model)
     crbm, preprocessor = pipeline[-1], pipeline[:-1]
-    train = _load_cmu35(args.data_home, "train")
-    Z = preprocessor.transform(train.data, sequence_ids=train.sequence_ids)
-    seeds = random_windows(
-        Z,
-        sequence_ids=train.sequence_ids,
-        width=max(crbm.history_length, 1),
-        n_windows=args.n_sequences,
-        sequences=np.flatnonzero(np.asarray(train.motion) == args.style),
-        random_state=args.seed,
-    )
     frames = crbm.sample(
         args.n_frames,
-        history=seeds,
+        history=_seeds(pipeline, args),
+        n_sequences=args.n_sequences,
         hidden_noise=args.hidden_noise,
         random_state=args.seed,
     )
     gen_ids = np.repeat(np.arange(args.n_sequences), args.n_frames)
     raw = preprocessor.inverse_transform(frames, sequence_ids=gen_ids)
+    skeleton = preprocessor[0].skeleton
     for k in range(args.n_sequences):
         path = Path(f"{args.output}_{k}.amc")
-        write_amc(
-            path, raw[gen_ids == k], train.skeleton, feature_names=train.feature_names
-        )
+        write_amc(path, raw[gen_ids == k], skeleton)
         print(f"wrote {path}")
     return 0
+
+
+def _seeds(pipeline, args):
+    """``sample``'s history: saved windows of the chosen style (None: any)."""
+    if args.style == "any":
+        return None
+    windows = getattr(pipeline, "style_windows_", None)
+    if windows is None:
+        raise ValueError(
+            f"{args.model} keeps no walking or jogging seed frames (it was saved "
+            "by an older version): fit it again with 'python -m sklearn_crbm "
+            "fit', or pass --style any."
+        )
+    windows = windows[args.style]
+    rng = np.random.default_rng(args.seed)
+    return windows[rng.integers(len(windows), size=args.n_sequences)]

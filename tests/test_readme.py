@@ -1,26 +1,147 @@
-"""The README's example runs as written (with fewer epochs)."""
+"""README and user guide: the quick start, the example and every snippet run.
 
+"As written" means: from the repository root, after the quick start's
+commands, in a fresh process whose home folder holds no data (so nothing
+relies on ``~/sklearn_crbm_data``), with the data where the quick start's
+``export`` says.  The one change is fewer training epochs (``n_iter``), so
+that the suite stays fast.  The ``>>>`` examples of the guide run as doctests
+in ``test_docs.py``; here the ``.. code-block:: python`` snippets run, each
+page's in order after its doctests and snippets above it, as a reader who
+types them one after the other would.
+"""
+
+import doctest
+import os
 import re
+import shlex
+import subprocess
+import sys
+import textwrap
 from pathlib import Path
 
-import numpy as np
+import pytest
 import sklearn
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+REPO_ROOT = Path(__file__).resolve().parents[1]
+README = REPO_ROOT / "README.md"
+CI_RUN = REPO_ROOT / ".ci" / "run"
+DOC_DIR = REPO_ROOT / "doc"
+FEW_EPOCHS = 2
+
+CODE_BLOCK = re.compile(
+    r"^( *)\.\. code-block:: python\n((?:\1 +.*\n|[ \t]*\n)*)", re.M
+)
+GUIDE_PAGES = [
+    DOC_DIR / "index.rst",
+    DOC_DIR / "getting_started.rst",
+    *sorted((DOC_DIR / "user_guide").glob("*.rst")),
+]
+SNIPPET_PAGES = [p for p in GUIDE_PAGES if CODE_BLOCK.search(p.read_text())]
 
 
-def test_readme_example_runs(data_home, monkeypatch):
-    text = README.read_text()
-    code = re.search(r"## Example\n\n```python\n(.*?)```", text, re.S).group(1)
-    quick = code.replace("n_iter=1000", "n_iter=3").replace(
-        "CRBMImputer(random_state=0)",
-        "CRBMImputer(ConditionalRBM(20, n_iter=3), random_state=0)",
+def markdown_block(heading, language):
+    text = README.read_text(encoding="utf-8")
+    section = text.split(f"## {heading}\n", 1)[1].split("\n## ", 1)[0]
+    return re.search(rf"```{language}\n(.*?)```", section, re.S).group(1)
+
+
+def quick_start():
+    """``(environment, commands)`` of README's quick start."""
+    env, commands = {}, []
+    for line in markdown_block("Quick start", "bash").splitlines():
+        line = line.split("#", 1)[0].strip()
+        if line.startswith("export "):
+            name, value = line[len("export ") :].split("=", 1)
+            env[name] = value.replace("$PWD", str(REPO_ROOT))
+        elif line:
+            commands.append(line)
+    return env, commands
+
+
+def fewer_epochs(code):
+    return re.sub(r"\bn_iter=\d+", f"n_iter={FEW_EPOCHS}", code)
+
+
+@pytest.fixture
+def after_quick_start(tmp_path, monkeypatch):
+    """The quick start's environment, and a home folder without data."""
+    env, _ = quick_start()
+    data = Path(env["SKLEARN_CRBM_DATA"])
+    assert (data / "cmu_subject35").is_dir(), (
+        f"README's quick start says the data is in {data}, but it is not there"
     )
-    assert quick.count("n_iter=3") == 2, "the README example changed: update this test"
-    monkeypatch.setenv("SKLEARN_CRBM_DATA", str(data_home))
+    monkeypatch.setenv("HOME", str(tmp_path))
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    monkeypatch.chdir(REPO_ROOT)
+    return dict(os.environ)
+
+
+def test_quick_start_is_what_ci_runs():
+    _, commands = quick_start()
+    assert commands == [
+        'pip install ".[plot]" && python -m sklearn_crbm demo',
+        'pip install -e ".[test]" && python -m pytest',
+    ]
+    install, test = (part.strip() for part in commands[1].split("&&"))
+    ci = [
+        line.strip()
+        for line in CI_RUN.read_text().splitlines()
+        if line.strip() and not line.startswith("#")
+    ]
+    # .ci/run installs what the quick start installs and runs exactly its tests
+    assert ci[-1] == test
+    assert any(
+        shlex.split(line)[-2:] == shlex.split(install)[-2:] and "pip install" in line
+        for line in ci
+    )
+
+
+def test_readme_example_runs_as_written(after_quick_start):
+    code = markdown_block("Example", "python")
+    assert code.count("n_iter=") == 1, "the README example changed: update this test"
+    result = subprocess.run(
+        [sys.executable, "-c", fewer_epochs(code)],
+        env=after_quick_start,
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert result.returncode == 0, result.stderr[-3000:]
+    printed = dict(line.split() for line in result.stdout.splitlines()[-2:])
+    assert set(printed) == {"CRBMImputer", "NearestNeighborImputer"}
+    assert all(float(error) > 0 for error in printed.values())
+
+
+def page_code(page):
+    """``(code, first line or None, raises)`` of the page's doctests and python
+    snippets, in page order; ``raises``: the doctest shows an exception."""
+    parts = []
+    for piece in doctest.DocTestParser().parse(page.read_text(encoding="utf-8")):
+        if isinstance(piece, str):
+            for match in CODE_BLOCK.finditer(piece):
+                snippet = textwrap.dedent(match.group(2))
+                first_line = snippet.strip().splitlines()[0]
+                parts.append((fewer_epochs(snippet), first_line, False))
+        else:
+            parts.append((piece.source, None, piece.exc_msg is not None))
+    return parts
+
+
+@pytest.mark.parametrize("page", SNIPPET_PAGES, ids=lambda p: p.stem)
+def test_guide_snippets_run_as_written(page, after_quick_start, capsys):
     namespace = {}
-    with sklearn.config_context():  # restores the config the example sets
-        exec(compile(quick, str(README), "exec"), namespace)
-    assert not sklearn.get_config()["enable_metadata_routing"]
-    assert namespace["raw"].shape == (1200, 62)
-    assert np.isfinite(namespace["raw"]).all()
+    with sklearn.config_context():  # pages switch metadata routing on
+        for code, first_line, raises in page_code(page):
+            try:
+                exec(compile(code, str(page), "exec"), namespace)
+            except Exception as exc:
+                if raises:
+                    continue
+                where = f"the snippet starting {first_line!r}" if first_line else code
+                raise AssertionError(f"{page.name}: {where} fails") from exc
+    import matplotlib.pyplot as plt
+
+    plt.close("all")

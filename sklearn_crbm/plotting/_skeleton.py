@@ -306,6 +306,7 @@ def plot_motion_strip(
     color="k",
     linewidth=1.5,
     ground=True,
+    max_figures=30,
 ):
     """Draw every ``step``-th frame side by side, like Fig. 3 of the paper.
 
@@ -344,6 +345,11 @@ def plot_motion_strip(
         Line width.
     ground : bool, default=True
         Draw a thin ground line under the figures.
+    max_figures : int or None, default=30
+        At most this many figures, so that they stay readable: when ``step``
+        would draw more, the step grows to ``ceil(n_frames / max_figures)``
+        and the strip still covers every frame.  ``None`` draws every
+        ``step``-th frame however many there are.
 
     Returns
     -------
@@ -366,6 +372,14 @@ def plot_motion_strip(
 
     if isinstance(step, bool) or not isinstance(step, Integral) or step < 1:
         raise ValueError(f"step must be a positive integer, got {step!r}.")
+    if max_figures is not None and (
+        isinstance(max_figures, bool)
+        or not isinstance(max_figures, Integral)
+        or max_figures < 1
+    ):
+        raise ValueError(
+            f"max_figures must be a positive integer or None, got {max_figures!r}."
+        )
     if not (
         (isinstance(spacing, str) and spacing == "auto")
         or (
@@ -375,6 +389,8 @@ def plot_motion_strip(
         raise ValueError(f"spacing must be 'auto' or a number >= 0, got {spacing!r}.")
     body, positions = _positions(skeleton, data, feature_names)
     segments, points = _side_segments(body, positions, horizontal)
+    if max_figures is not None:
+        step = max(step, -(-len(positions) // max_figures))
     drawn = np.arange(0, len(positions), step)
     segments, points = segments[drawn], points[drawn]
     if spacing == "auto":

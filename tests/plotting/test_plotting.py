@@ -69,6 +69,22 @@ def test_plot_skeleton_3d_and_horizontal(walker):
         plot_skeleton(walker.skeleton, walker.data[0], horizontal=(0, 1, 0))
 
 
+def test_motion_strip_keeps_long_sequences_readable():
+    long_walk = make_walker(n_sequences=1, n_frames=300, random_state=0)
+    skeleton, data = long_walk.skeleton, long_walk.data
+    # step 6 would be 50 figures: 30 instead, frames 0, 10, ..., 290
+    ax = plot_motion_strip(skeleton, data, step=6, spacing=0)
+    every_10th = plot_motion_strip(skeleton, data, step=10, max_figures=None, spacing=0)
+    assert len(ax.collections) == 30
+    for a, b in zip(ax.collections, every_10th.collections, strict=True):
+        assert_allclose(np.asarray(a.get_segments()), np.asarray(b.get_segments()))
+    ax = plot_motion_strip(skeleton, data, step=6, max_figures=None)
+    assert len(ax.collections) == 50
+    with pytest.raises(ValueError, match="max_figures"):
+        plot_motion_strip(skeleton, data, max_figures=0)
+    plt.close("all")
+
+
 def test_motion_strip_draws_every_step_frames_left_to_right(walker):
     ax = plot_motion_strip(walker.skeleton, walker.data, step=5)
     assert len(ax.collections) == 8
