@@ -81,7 +81,7 @@ def after_quick_start(tmp_path, monkeypatch):
 def test_quick_start_is_what_ci_runs():
     _, commands = quick_start()
     assert commands == [
-        'pip install ".[plot]" && python -m sklearn_crbm demo',
+        'pip install ".[plot]" && python -m sklearn_crbm demo --data-home ../shared/data',
         'pip install -e ".[test]" && python -m pytest',
     ]
     install, test = (part.strip() for part in commands[1].split("&&"))
