@@ -624,28 +624,6 @@ def sample_visible_states(params, means, rng, out=None):
     return params.ops.add(means, noise, out=noise)
 
 
-def free_energy(params, visible, visible_bias, hidden_bias):
-    """F(v | history), so that p(v | history) is proportional to exp(-F).
-
-    Gaussian: ``sum_i (v_i - c_hat_i)^2 / (2 s_i^2) - sum_j softplus(b_hat_j +
-    W_j . (v / s))``; binary: ``-c_hat . v - sum_j softplus(b_hat_j + W_j . v)``.
-    """
-    std = params.visible_std
-    scaled = visible if std is None else visible / std
-    activation = scaled @ params.weights.T
-    activation += hidden_bias
-    with np.errstate(under="ignore"):  # softplus(-1e4) = 0 exactly enough
-        softplus = np.logaddexp(0, activation).sum(axis=1)
-    if params.visible_type == GAUSSIAN:
-        residual = visible - visible_bias
-        if std is not None:
-            residual /= std
-        quadratic = 0.5 * np.square(residual).sum(axis=1)
-    else:
-        quadratic = -(visible * visible_bias).sum(axis=1)
-    return quadratic - softplus
-
-
 class CDWorkspace:
     """Buffers that :func:`cd_gradients` reuses from one minibatch to the next.
 
