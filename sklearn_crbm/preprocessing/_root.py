@@ -336,7 +336,8 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
                     f"X has {X.shape[1]} feature(s); RootRelativeEncoder needs the "
                     f"{len(channels)} root channels ({', '.join(channels)}), which "
                     "without feature names or a skeleton are the first "
-                    f"{len(channels)} columns."
+                    f"{len(channels)} columns; for a root with fewer channels "
+                    "pass channels=."
                 )
             columns = np.arange(len(channels))
             names = np.asarray([f"x{i}" for i in range(X.shape[1])], dtype=object)
