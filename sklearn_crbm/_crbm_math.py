@@ -770,8 +770,9 @@ def cd_gradients(
     gradients : CRBMParameters
         Sums over the batch (not means), group by group; ascent directions
         (``out`` if given).
-    squared_error : float
-        Sum over the batch of ``||v - v_recon||^2``.
+    squared_error : float or 0-d array
+        Sum over the batch of ``||v - v_recon||^2`` (a 0-d array of the
+        namespace for other namespaces than numpy).
     """
     n, d = visible.shape
     ops = params.ops
@@ -816,7 +817,7 @@ def cd_gradients(
     visible_delta = ops.subtract(data, reconstruction, out=delta[:, :d])
     ops.subtract(positive_states, negative_probabilities, out=delta[:, d:])
     squared_error = ops.einsum("ij,ij->", visible_delta, visible_delta)
-    if ops is np:  # elsewhere a device scalar: no synchronisation per minibatch
+    if ops is np:  # elsewhere it stays on the device: no sync per minibatch
         squared_error = float(squared_error)
 
     if learned:
