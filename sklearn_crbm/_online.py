@@ -199,6 +199,53 @@ class Observed:
     sequences: Sequences
 
 
+class Offsets:
+    """Each chain's systematic one-step error per sequence and channel.
+
+    A model that fills a sequence from its own past drifts towards its own
+    typical values (a slow posture channel towards the training posture);
+    while a channel is observed, its one-step residual ``r_t = x_t -
+    x_hat_t`` (``x_hat_t`` the chain's mean-field prediction of the frame
+    from its past, :func:`~sklearn_crbm._crbm_math.stacked_prediction`)
+    shows that error.  The correction of a missing entry is the posterior
+    mean of a constant offset ``d`` behind the residuals, ``r_t = d +
+    noise``, with a prior worth ``shrinkage`` frames of zero residual:
+    ``sum(r) / (n + shrinkage)`` over the ``n`` frames of the sequence in
+    which the channel was observed so far (counted from the model's order
+    on: earlier frames have an edge-padded past).
+
+    Parameters
+    ----------
+    n_chains, n_sequences, n_features : int
+    dtype : dtype
+    shrinkage : float
+    """
+
+    def __init__(self, n_chains, n_sequences, n_features, dtype, shrinkage):
+        self.sums = np.zeros((n_chains, n_sequences, n_features), dtype)
+        self.counts = np.zeros((n_sequences, n_features), dtype)
+        self.shrinkage = shrinkage
+
+    def update(self, layers, biases, sequences, frames, observed):
+        """Add the residuals of ``frames`` (one per sequence) where ``observed``."""
+        n_chains = self.sums.shape[0]
+        prediction = stacked_prediction(
+            layers, *_split(layers, biases), PREDICTION_STEPS
+        ).reshape(n_chains, *frames.shape)
+        self.sums[:, sequences] += np.where(observed, frames - prediction, 0)
+        self.counts[sequences] += observed
+
+    def correction(self, sequences, missing):
+        """What to add to each chain's fill of ``sequences``: 0 where observed."""
+        # a channel never observed has a zero sum; the floor spares 0 / 0
+        denominator = np.maximum(self.counts[sequences] + self.shrinkage, 1)
+        return np.where(missing, self.sums[:, sequences] / denominator, 0)
+
+    def reorder(self, chains, sequences):
+        """The chains' offsets follow their pasts (:meth:`History.reorder`)."""
+        self.sums[:, sequences] = self.sums[chains, sequences[None, :]]
+
+
 def run_online(
     layers,
     rng,
@@ -213,6 +260,7 @@ def run_online(
     start_jitter=0.0,
     hidden_noise=0.0,
     sample_visibles=False,
+    offset_shrinkage=None,
 ):
     """Draw frames one after another, each given the chains' own past.
 
@@ -259,6 +307,11 @@ def run_online(
     sample_visibles : bool, default=False
         Draw the visibles at every step (:func:`gibbs_frames`); one layer,
         or the top layer with :data:`TOP_LAYER`.
+    offset_shrinkage : float, default=None
+        Fill-in only.  ``None``: no correction.  A number ``lam >= 0``: each
+        chain's drawn entries are shifted by the chain's
+        :class:`Offsets` correction (its mean one-step residual of that
+        channel in that sequence so far, shrunk by ``lam`` frames).
 
     Yields
     ------
@@ -335,6 +388,9 @@ def run_online(
     starts, lengths = all_sequences.starts, all_sequences.lengths
     n_features = X.shape[1]
     n_steps = int(lengths.max(initial=0)) if n_steps is None else n_steps
+    offsets = None
+    if offset_shrinkage is not None:
+        offsets = Offsets(n_chains, len(starts), n_features, X.dtype, offset_shrinkage)
     for step in range(n_steps):
         sequences = np.flatnonzero(lengths > step)
         rows = starts[sequences] + step
@@ -357,7 +413,7 @@ def run_online(
             yield step, sequences, drawn, current[:, drawn]
             continue
         if n_particles > 1 and len(drawn):
-            _resample(
+            chains = _resample(
                 history,
                 sequences[drawn],
                 frames[drawn],
@@ -365,7 +421,11 @@ def run_online(
                 n_particles,
                 rng,
             )
+            if offsets is not None:
+                offsets.reorder(chains, sequences[drawn])
         biases = history.biases(sequences)
+        if offsets is not None and step >= layers[0].n_lags:
+            offsets.update(layers, biases, sequences, frames, ~frame_missing)
         if len(drawn):
             start = np.where(
                 frame_missing[drawn],
@@ -375,6 +435,10 @@ def run_online(
             if start_jitter:
                 start += start_jitter * rng.standard_normal(start.shape, start.dtype)
             current[:, drawn] = draw(start, [b[:, drawn] for b in biases], clamp)[0]
+            if offsets is not None:
+                current[:, drawn] += offsets.correction(
+                    sequences[drawn], frame_missing[drawn]
+                )
         yield step, sequences, drawn, current[:, drawn]
         history.push([current], sequences, biases)
 
@@ -386,7 +450,8 @@ def _resample(history, sequences, frames, observed, n_particles, rng):
     under its own one-step prediction
     (:func:`~sklearn_crbm._crbm_math.observed_log_likelihood`); each group is
     resampled (systematic resampling) and the pasts of the chosen ancestors
-    copied, before the frame is drawn.
+    copied, before the frame is drawn.  Returns the ancestors, as
+    :meth:`History.reorder` takes them.
     """
     layers = history.layers
     n_chains = history.windows[0].shape[0]
@@ -411,7 +476,9 @@ def _resample(history, sequences, frames, observed, n_particles, rng):
     ancestors = (cumulative[:, None, :, :] < positions[:, :, None, :]).sum(axis=2)
     np.minimum(ancestors, n_particles - 1, out=ancestors)
     chains = ancestors + (np.arange(n_groups) * n_particles)[:, None, None]
-    history.reorder(chains.reshape(n_chains, len(sequences)), sequences)
+    chains = chains.reshape(n_chains, len(sequences))
+    history.reorder(chains, sequences)
+    return chains
 
 
 def _split(layers, biases):

@@ -5,7 +5,7 @@ import os
 import numpy as np
 
 from ._asf import content_lines
-from ._channels import as_frames, column_indices
+from ._channels import frame_columns
 from ._parsing import format_number, parse_error, parse_floats
 from ._skeleton import Skeleton
 
@@ -206,14 +206,9 @@ def write_amc(path, data, skeleton, feature_names=None):
 
 def _ordered_channels(data, skeleton, feature_names):
     """``data`` as floats with its columns in ``skeleton.feature_names`` order."""
-    X = as_frames(data)
-    if X.ndim != 2:
-        raise ValueError(
-            f"data must be 2-D (n_frames, n_features), got shape {X.shape}."
-        )
     names = skeleton.feature_names if feature_names is None else feature_names
     wanted = list(skeleton.feature_names)
-    columns = column_indices(names, wanted, n_columns=X.shape[1])
+    X, columns = frame_columns(data, names, wanted)
     X = X[:, [columns[name] for name in wanted]]
     if X.shape[0] == 0:
         raise ValueError(

@@ -36,8 +36,7 @@ from ._channels import (
     EXPMAP_CHANNELS,
     OFFSET_CHANNELS,
     TRANSLATION_CHANNELS,
-    as_frames,
-    column_indices,
+    frame_columns,
 )
 from ._mit import parse_mit_skeleton
 
@@ -303,14 +302,8 @@ class Skeleton:
         ]
 
     def _columns(self, data, feature_names):
-        X = as_frames(data)
-        if X.ndim != 2:
-            raise ValueError(
-                f"data must be 2-D (n_frames, n_features), got shape {X.shape}."
-            )
         names = self.feature_names if feature_names is None else feature_names
-        columns = column_indices(names, self._required_channels(), n_columns=X.shape[1])
-        return X, columns
+        return frame_columns(data, names, self._required_channels())
 
     def _angles(self, X, columns, bone, channel_names):
         cols = [columns[f"{bone.name}_{c}"] for c in channel_names]

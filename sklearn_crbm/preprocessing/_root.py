@@ -23,6 +23,7 @@ from ._layout import (
     check_encoded,
     check_skeleton,
     expmap_feature_names,
+    input_names,
     moving_root,
 )
 
@@ -284,21 +285,6 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             check_skeleton(self.skeleton)
         return moving_root(names, X, self.skeleton) or "root"
 
-    def _layout_names(self, n_features):
-        if hasattr(self, "feature_names_in_"):
-            return np.asarray(self.feature_names_in_, dtype=object)
-        if self.skeleton is not None:
-            names = expmap_feature_names(self.skeleton)
-            if len(names) != n_features:
-                raise ValueError(
-                    f"X has {n_features} columns but the skeleton's channels, "
-                    f"after ExpMapEncoder, are {len(names)}; a plain array must "
-                    "hold exactly those columns, in order (or pass a DataFrame "
-                    "with column names)."
-                )
-            return names
-        return None
-
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None, *, sequence_ids=None):
         """Locate the root channels.
@@ -327,7 +313,12 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             raise ValueError(f"up_axis must be 'x', 'y' or 'z', got {up!r}.")
         self.up_axis_ = up
         channels = self._check_channels(up)
-        names = self._layout_names(X.shape[1])
+        names = input_names(
+            self,
+            X.shape[1],
+            expmap_feature_names,
+            "the skeleton's channels, after ExpMapEncoder, are {}",
+        )
         root = self._root_name(names, X)
         wanted = [f"{root}_{c}" for c in channels]
         if names is None:
