@@ -98,16 +98,18 @@ ORIGINAL_MODEL = {
 }
 # The training-side fix: noisy histories (ConditionalRBM's ``history_noise``).
 NOISY_MODEL = dict(ORIGINAL_MODEL, history_noise=0.4)
+# The paper's on-line procedure (CRBMImputer's offset correction off).
+PAPER_FILLIN = dict(n_gibbs=30, offset_shrinkage=None)
 VARIANTS = {
-    "original": dict(model=ORIGINAL_MODEL, imputer=dict(n_gibbs=30, n_particles=1)),
-    "particles": dict(model=ORIGINAL_MODEL, imputer=dict(n_gibbs=30, n_particles=10)),
-    "noisy": dict(model=NOISY_MODEL, imputer=dict(n_gibbs=30, n_particles=1)),
-    "robust": dict(model=NOISY_MODEL, imputer=dict(n_gibbs=30, n_particles=10)),
+    "original": dict(model=ORIGINAL_MODEL, imputer=dict(PAPER_FILLIN, n_particles=1)),
+    "particles": dict(model=ORIGINAL_MODEL, imputer=dict(PAPER_FILLIN, n_particles=10)),
+    "noisy": dict(model=NOISY_MODEL, imputer=dict(PAPER_FILLIN, n_particles=1)),
+    "robust": dict(model=NOISY_MODEL, imputer=dict(PAPER_FILLIN, n_particles=10)),
     # ConditionalRBM's default noise level, which also keeps generated
     # styles stable (generation_seeds.py)
     "noisy0.8": dict(
         model=dict(ORIGINAL_MODEL, history_noise=0.8),
-        imputer=dict(n_gibbs=30, n_particles=1),
+        imputer=dict(PAPER_FILLIN, n_particles=1),
     ),
 }
 

@@ -9,6 +9,7 @@ from sklearn.base import (
     ClassNamePrefixFeaturesOutMixin,
     TransformerMixin,
 )
+from sklearn.utils._array_api import check_same_namespace, get_namespace
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import (
     _check_sample_weight,
@@ -27,6 +28,7 @@ from ._likelihood import (
     stack_log_likelihood_bound,
 )
 from ._online import History, run_online
+from .utils._array_api import array_ops, array_random, is_numpy
 from .utils._parallel import map_sequence_blocks
 from .utils._persistence import VersionedPickleMixin
 from .utils._random import rng_from
@@ -153,21 +155,47 @@ class BaseCRBM(
         width = max(self.history_length, 1)
         ends = evenly_spaced(sequences.valid_frames(width - 1) + 1, MAX_SEED_WINDOWS)
         rows = ends[:, None] - np.arange(width, 0, -1)
-        return X[rows].astype(self._layer_parameters()[0].dtype, copy=True)
+        ops = array_ops(X)
+        windows = ops.take(X, rows.ravel(), axis=0)
+        windows = ops.reshape(windows, (*rows.shape, X.shape[1]))
+        return ops.astype(windows, self._layer_parameters()[0].dtype, copy=True)
 
     def _merge_seed_windows(self, new):
         """Seed windows of a ``partial_fit`` call joined to the earlier ones."""
         if not hasattr(self, "seed_windows_"):
             return new
-        windows = np.concatenate((self.seed_windows_, new))
-        return windows[evenly_spaced(np.arange(len(windows)), MAX_SEED_WINDOWS)]
+        ops = array_ops(new)
+        windows = ops.concatenate((self.seed_windows_, new))
+        picks = evenly_spaced(np.arange(windows.shape[0]), MAX_SEED_WINDOWS)
+        return ops.take(windows, picks, axis=0)
 
     # ------------------------------------------------------------ inference
 
-    def _check_inference_input(self, X, sequence_ids):
+    @property
+    def _packed_parameters(self):
+        """The bottom layer's parameter buffer: the fitted namespace and device."""
+        return self._layer_parameters()[0].flat
+
+    def _check_namespace(self, X, method):
+        """A clear error unless ``X`` can meet the fitted parameters."""
+        flat = self._packed_parameters
+        if not is_numpy(flat) and not get_namespace(X)[1]:
+            raise ValueError(
+                f"{type(self).__name__} was fitted on {type(flat).__module__} "
+                f"arrays; {method} needs sklearn.set_config(array_api_dispatch=True) "
+                "and input of that namespace and device, or a model moved to numpy "
+                "with sklearn.utils._array_api.move_estimator_to(model, numpy, "
+                "'cpu')."
+            )
+        check_same_namespace(X, self, attribute="_packed_parameters", method=method)
+
+    def _check_inference_input(self, X, sequence_ids, method="transform"):
         check_is_fitted(self)
-        X = validate_data(self, X, dtype=[np.float64, np.float32], reset=False)
-        X = X.astype(self._layer_parameters()[0].dtype, copy=False)
+        self._check_namespace(X, method)
+        xp = get_namespace(X)[0]
+        X = validate_data(self, X, dtype=[xp.float64, xp.float32], reset=False)
+        ops = array_ops(X)
+        X = ops.astype(X, self._layer_parameters()[0].dtype, copy=False)
         return X, check_sequence_ids(sequence_ids, X.shape[0])
 
     def _representations(self, X, sequences, layers):
@@ -232,14 +260,14 @@ class BaseCRBM(
         X_pred : ndarray of shape (n_frames, n_features)
             Predicted frames.
         """
-        X, sequences = self._check_inference_input(X, sequence_ids)
+        X, sequences = self._check_inference_input(X, sequence_ids, "predict_next")
         return self._predict_frames(X, sequences)
 
     def _predict_frames(self, X, sequences, frames=None):
         layers = self._layer_parameters()
         representations = self._representations(X, sequences, layers[:-1])
         frames = np.arange(X.shape[0]) if frames is None else frames
-        predicted = np.empty((len(frames), X.shape[1]), dtype=X.dtype)
+        predicted = array_ops(X).empty((len(frames), X.shape[1]), dtype=X.dtype)
         chunks = zip(
             *(
                 sequence_dynamic_biases(params, values, sequences, frames)
@@ -250,7 +278,7 @@ class BaseCRBM(
         position = 0
         for per_layer in chunks:
             rows = per_layer[0][0]
-            predicted[position : position + len(rows)] = stacked_prediction(
+            predicted[position : position + len(rows), ...] = stacked_prediction(
                 layers,
                 [visible_bias for _, visible_bias, _ in per_layer],
                 [hidden_bias for _, _, hidden_bias in per_layer],
@@ -296,8 +324,9 @@ class BaseCRBM(
             Log density (Gaussian visibles) or log probability (binary) of
             each frame given its history, in the dtype of the model.
         """
-        X, sequences = self._check_inference_input(X, sequence_ids)
-        return self._log_likelihood(X, sequences).log_likelihood.astype(X.dtype)
+        X, sequences = self._check_inference_input(X, sequence_ids, "score_samples")
+        log_likelihood = self._log_likelihood(X, sequences).log_likelihood
+        return array_ops(X).astype(log_likelihood, X.dtype)
 
     def _ais_settings(self):
         """Intermediate distributions and chains per frame of the annealing."""
@@ -309,13 +338,14 @@ class BaseCRBM(
         """Standard deviation of the bottom layer's Gaussian visibles (or None)."""
         bottom = getattr(self, "layers_", [self])[0]
         variance = getattr(bottom, "visible_variance_", None)
-        return None if variance is None else np.sqrt(variance)
+        return None if variance is None else array_ops(variance).sqrt(variance)
 
     def _log_likelihood(self, X, sequences, method="auto", reverse=False, rng=None):
         """:class:`~sklearn_crbm._likelihood.LogLikelihood` of every frame."""
         layers = self._layer_parameters()
         n_steps, n_chains = self._ais_settings()
         rng = rng_from(self.random_state) if rng is None else rng
+        rng = array_random(rng, X)  # numpy's own stream for numpy input
         if len(layers) == 1:
             return frame_log_likelihood(
                 layers[0],
@@ -342,7 +372,7 @@ class BaseCRBM(
             bounds.append(
                 stack_log_likelihood_bound(
                     list(zip(layers, scales, strict=True)),
-                    X[per_layer[0][0]],
+                    array_ops(X).take(X, per_layer[0][0], axis=0),
                     [
                         (visible_bias, hidden_bias)
                         for _, visible_bias, hidden_bias in per_layer
@@ -354,8 +384,9 @@ class BaseCRBM(
                     n_chains=n_chains,
                 )
             )
-        bound = np.concatenate(bounds)
-        return LogLikelihood(bound, None, np.zeros_like(bound), "bound")
+        ops = array_ops(X)
+        bound = ops.concatenate(bounds)
+        return LogLikelihood(bound, None, ops.zeros_like(bound), "bound")
 
     @limit_blas_threads(frame_rows)
     def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
@@ -389,7 +420,7 @@ class BaseCRBM(
         score : float
             Mean log-likelihood per frame.
         """
-        X, sequences = self._check_inference_input(X, sequence_ids)
+        X, sequences = self._check_inference_input(X, sequence_ids, "score")
         frames = sequences.valid_frames(self.history_length)
         if len(frames) == 0:
             raise ValueError(
@@ -397,12 +428,14 @@ class BaseCRBM(
                 "their own sequence; every sequence given is shorter. Pass longer "
                 "sequences."
             )
-        weights = None
-        if sample_weight is not None:
-            weights = _check_sample_weight(sample_weight, X)[frames]
+        ops = array_ops(X)
         # every frame, as score_samples draws them: the same random numbers
-        log_likelihood = self._log_likelihood(X, sequences).log_likelihood[frames]
-        return float(np.average(log_likelihood, weights=weights))
+        log_likelihood = self._log_likelihood(X, sequences).log_likelihood
+        log_likelihood = ops.take(log_likelihood, frames, axis=0)
+        if sample_weight is None:
+            return float(ops.mean(log_likelihood))
+        weights = ops.take(_check_sample_weight(sample_weight, X), frames, axis=0)
+        return float(ops.sum(log_likelihood * weights) / ops.sum(weights))
 
     # ----------------------------------------------------------- generation
 
@@ -496,13 +529,15 @@ class BaseCRBM(
             seed_windows=self.seed_windows_,
             rng=rng,
         )
-        past = History.from_frames(layers, seed[None])
+        past = History.from_frames(layers, seed[None, ...])
+        ops = layers[0].ops
 
         def generate_block(block, block_rng):
-            frames = np.empty((len(block), n_samples, seed.shape[2]), seed.dtype)
+            shape = (len(block), n_samples, seed.shape[2])
+            frames = ops.empty(shape, seed.dtype)
             run = run_online(
                 layers,
-                block_rng,
+                array_random(block_rng, seed),
                 history=past.select(block),
                 n_steps=n_samples,
                 n_gibbs=n_gibbs,
@@ -512,17 +547,18 @@ class BaseCRBM(
                 sample_visibles=sample_visibles,
             )
             for step, _, _, new in run:
-                frames[:, step] = new[0]
+                frames[:, step, ...] = new[0, ...]
             return frames
 
         blocks = map_sequence_blocks(
             generate_block,
-            len(seed),
+            seed.shape[0],
             self._chain_rng(rng),
             n_jobs,
-            block_size=SAMPLE_BLOCK,
+            # an accelerator runs every sequence in one pass
+            block_size=SAMPLE_BLOCK if ops is np else seed.shape[0],
         )
-        return np.concatenate(blocks).reshape(-1, self.n_features_in_)
+        return ops.reshape(ops.concatenate(blocks), (-1, self.n_features_in_))
 
     # ---------------------------------------------------------------- misc
 
@@ -568,7 +604,7 @@ class FittedParameter:
 
     def __set__(self, instance, value):
         view = self.__get__(instance)
-        value = np.asarray(value)
+        value = array_ops(view).asarray(value)
         if value.shape != view.shape:
             raise ValueError(
                 f"{self.name} has shape {view.shape}; got an array of shape "
@@ -589,19 +625,20 @@ def seed_frames(history, n_sequences, *, width, n_features, dtype, seed_windows,
     2-D history seeds every sequence with its last ``width`` rows; a 3-D one
     gives one seed per sequence.  Oldest frame first.
     """
+    ops = array_ops(seed_windows)
     if history is None:
-        picks = rng.integers(len(seed_windows), size=n_sequences)
-        return seed_windows[picks]
+        picks = rng.integers(seed_windows.shape[0], size=n_sequences)
+        return ops.take(seed_windows, picks, axis=0)
     if hasattr(history, "toarray") or hasattr(history, "tocsr"):
         raise TypeError("history must be a dense array, got a sparse matrix.")
     try:
-        history = np.asarray(history, dtype=dtype)
+        history = ops.asarray(history, dtype=dtype)
     except (TypeError, ValueError) as exc:
         raise TypeError(
             f"history must be an array of numbers, got {type(history).__name__}."
         ) from exc
     if history.ndim == 2:
-        history = np.broadcast_to(history, (n_sequences, *history.shape))
+        history = ops.broadcast_to(history, (n_sequences, *history.shape))
     elif history.ndim == 3:
         if n_sequences not in (1, history.shape[0]):
             raise ValueError(
@@ -618,9 +655,9 @@ def seed_frames(history, n_sequences, *, width, n_features, dtype, seed_windows,
             f"history must hold at least {width} frames of {n_features} features "
             f"each, got shape {history.shape}."
         )
-    if not np.isfinite(history).all():
+    if not ops.all(ops.isfinite(history)):
         raise ValueError("history contains NaN or infinity.")
-    return np.ascontiguousarray(history[:, -width:])
+    return ops.ascontiguousarray(history[:, -width:, ...])
 
 
 def evenly_spaced(values, at_most):

@@ -1,11 +1,19 @@
 """Conditional Restricted Boltzmann Machine (Taylor, Hinton & Roweis, 2006)."""
 
+import math
 import time
+from functools import partial
 from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import _fit_context
+from sklearn.externals import array_api_compat
 from sklearn.utils import Bunch, check_random_state
+from sklearn.utils._array_api import (
+    _convert_to_numpy,
+    get_namespace_and_device,
+    move_to,
+)
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import validate_data
 
@@ -18,6 +26,7 @@ from ._crbm_math import (
     MomentumUpdate,
     cd_gradients,
 )
+from .utils._array_api import array_ops, array_random
 from .utils._autoregression import ridge_autoregression
 from .utils._fitting import unfitted_on_error
 from .utils._random import rng_from
@@ -404,10 +413,11 @@ class ConditionalRBM(BaseCRBM):
             The fitted model.
         """
         with unfitted_on_error(self):
-            X = validate_data(self, X, dtype=[np.float64, np.float32], reset=True)
+            xp, _ = get_namespace_and_device(X)[:2]
+            X = validate_data(self, X, dtype=[xp.float64, xp.float32], reset=True)
             sequences, frames = self._check_sequences(X, sequence_ids)
             self.random_state_ = check_random_state(self.random_state)
-            self._initialize(X.shape[1], X.dtype)
+            self._initialize(X)
             if self.early_stopping:
                 self._train_with_early_stopping(X, sequences)
             else:
@@ -441,10 +451,13 @@ class ConditionalRBM(BaseCRBM):
         first_call = not hasattr(self, "components_")
         # bad input leaves a fitted model as it was; divergence unfits it
         with unfitted_on_error(self, Exception if first_call else ()):
+            xp = get_namespace_and_device(X)[0]
+            if not first_call:
+                self._check_namespace(X, "partial_fit")
             X = validate_data(
                 self,
                 X,
-                dtype=[np.float64, np.float32]
+                dtype=[xp.float64, xp.float32]
                 if first_call
                 else self._parameters.dtype,
                 reset=first_call,
@@ -453,7 +466,7 @@ class ConditionalRBM(BaseCRBM):
         with unfitted_on_error(self):
             if first_call:
                 self.random_state_ = check_random_state(self.random_state)
-                self._initialize(X.shape[1], X.dtype)
+                self._initialize(X)
                 self._start_autoregressive(X, frames)
             self._train(X, frames, 1)
         self.seed_windows_ = self._merge_seed_windows(
@@ -487,10 +500,12 @@ class ConditionalRBM(BaseCRBM):
                 "init='autoregressive' starts from a linear-Gaussian model and "
                 "needs Gaussian visibles. Use init='random' with binary visibles."
             )
-        if self.visible_type == BINARY and (X.min() < 0 or X.max() > 1):
+        ops = array_ops(X)
+        low, high = float(ops.min(X)), float(ops.max(X))
+        if self.visible_type == BINARY and (low < 0 or high > 1):
             raise ValueError(
                 "visible_type='binary' needs data in [0, 1] (binary values or "
-                f"probabilities); got values in [{X.min():g}, {X.max():g}]. Use "
+                f"probabilities); got values in [{low:g}, {high:g}]. Use "
                 "visible_type='gaussian' for standardised real-valued data."
             )
         frames = sequences.valid_frames(self._n_lags)
@@ -505,17 +520,28 @@ class ConditionalRBM(BaseCRBM):
             )
         return sequences, frames
 
-    def _initialize(self, n_features, dtype):
+    def _initialize(self, X):
+        """Draw the start parameters, in the namespace and on the device of ``X``.
+
+        They are drawn with numpy (the same numbers for every namespace) and
+        moved to ``X``'s namespace and device.
+        """
+        ops = array_ops(X)
         params = CRBMParameters.initialize(
-            n_features,
+            X.shape[1],
             self.n_components,
             self.order,
             self._hidden_order,
             self.visible_type,
-            dtype,
+            np.float32 if X.dtype == ops.float32 else np.float64,
             rng_from(self.random_state_),
             learned_variance=self.visible_variance == "learned",
         )
+        if ops is not np:
+            xp, _, device = get_namespace_and_device(X)
+            params = params.__sklearn_array_api_convert__(
+                partial(move_to, xp=xp, device=device)
+            )
         self.n_iter_ = 0
         self._parameters = params
         self._velocity = params.zeros_like(layout="F")
@@ -529,14 +555,15 @@ class ConditionalRBM(BaseCRBM):
         """
         if self.init != "autoregressive":
             return
-        params = self._parameters
+        if not isinstance(X, np.ndarray):  # array API input: fitted with numpy
+            X = _convert_to_numpy(X, array_api_compat.array_namespace(X))
         fit = ridge_autoregression(
             X.astype(np.float64), frames, self.order, _AUTOREGRESSIVE_ALPHA
         )
-        params.autoregressive[...] = fit.coef
-        params.visible_bias[...] = fit.intercept
-        if params.learned_variance:
-            params.visible_variance = np.maximum(
+        self.autoregressive_ = fit.coef
+        self.intercept_visible_ = fit.intercept
+        if self._parameters.learned_variance:
+            self.visible_variance_ = np.maximum(
                 np.mean(np.square(fit.residual), axis=0), np.exp(MIN_LOG_VARIANCE)
             )
 
@@ -550,7 +577,8 @@ class ConditionalRBM(BaseCRBM):
         self._velocity = update.velocity
         # Minibatches gather rows: from a Fortran-ordered X (what many
         # transformers return) every row would be a strided read.
-        X = np.ascontiguousarray(X)
+        ops = array_ops(X)
+        X = ops.ascontiguousarray(X)
         plan_batches = (
             balanced_batches if self.batching == "balanced" else shuffled_batches
         )
@@ -560,18 +588,20 @@ class ConditionalRBM(BaseCRBM):
         start = time.perf_counter()
         for _ in range(n_epochs):
             rng = rng_from(self.random_state_)
+            # minibatches are planned with numpy; the math draws on X's device
+            math_rng = array_random(rng, X)
             momentum = self.momentum if self.n_iter_ >= self.momentum_delay else 0.0
             squared_error = 0.0
             for batch in plan_batches(frames, self.batch_size, rng):
                 n = len(batch)
-                visible = np.take(
+                visible = ops.take(
                     X, batch, axis=0, out=workspace.visible(n), mode="clip"
                 )
                 batch_history = frame_history(
-                    X, batch, n_lags, out=workspace.history[:n]
+                    X, batch, n_lags, out=workspace.history[:n, ...]
                 )
                 if self.history_noise:
-                    batch_history += self.history_noise * rng.standard_normal(
+                    batch_history += self.history_noise * math_rng.standard_normal(
                         batch_history.shape, dtype=batch_history.dtype
                     )
                 _, error = cd_gradients(
@@ -579,7 +609,7 @@ class ConditionalRBM(BaseCRBM):
                     visible,
                     batch_history,
                     self.cd_steps,
-                    rng,
+                    math_rng,
                     out=update.statistics,
                     scale=self.learning_rate / n,
                     workspace=workspace,
@@ -587,14 +617,15 @@ class ConditionalRBM(BaseCRBM):
                 squared_error += error
                 update.apply(momentum, self.learning_rate, self.weight_decay)
                 if params.learned_variance:
-                    np.maximum(
+                    ops.maximum(
                         params.log_visible_variance,
                         MIN_LOG_VARIANCE,
                         out=params.log_visible_variance,
                     )
+            squared_error = float(squared_error)  # one device sync per epoch
             self.n_iter_ += 1
             self.reconstruction_error_ = squared_error / len(frames)
-            if not params.is_finite() or not np.isfinite(squared_error):
+            if not params.is_finite() or not math.isfinite(squared_error):
                 self._parameters = params.copy(layout="C")
                 raise TrainingDivergedError(
                     f"Training diverged at epoch {self.n_iter_}: the weights became "
@@ -625,7 +656,8 @@ class ConditionalRBM(BaseCRBM):
                     f" frame has {self._n_lags} past frames in its sequence; pass "
                     "longer sequences or raise validation_fraction."
                 )
-            parts.append((X[mask], part, frames))
+            rows = np.flatnonzero(mask)
+            parts.append((array_ops(X).take(X, rows, axis=0), part, frames))
         (X_train, _, train_frames), (X_valid, valid, valid_frames) = parts
         self._start_autoregressive(X_train, train_frames)
         # the same random numbers at every check: changes are the model's
@@ -648,6 +680,11 @@ class ConditionalRBM(BaseCRBM):
                 break
         self._parameters = best_parameters
         self.best_validation_score_ = best
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.array_api_support = True
+        return tags
 
     @limit_blas_threads(frame_rows)
     def estimate_log_likelihood(
@@ -708,7 +745,9 @@ class ConditionalRBM(BaseCRBM):
             raise ValueError(
                 f"method must be 'auto', 'exact' or 'ais', got {method!r}."
             )
-        X, sequences = self._check_inference_input(X, sequence_ids)
+        X, sequences = self._check_inference_input(
+            X, sequence_ids, "estimate_log_likelihood"
+        )
         rng = rng_from(self.random_state if random_state is None else random_state)
         result = self._log_likelihood(
             X, sequences, method=method, reverse=reverse, rng=rng

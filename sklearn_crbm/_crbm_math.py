@@ -30,12 +30,14 @@ holds ``z = log s^2``.  With binary visibles the quadratic term becomes
 (W.T h)_i)``.
 """
 
+import copy
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
+from .utils._array_api import array_ops, copy_array, same_memory
 from .utils._sequences import frame_history
 
 GAUSSIAN = "gaussian"
@@ -59,8 +61,16 @@ def uniform(rng, shape, dtype, out=None, *, symmetric=False):
     matters in Gibbs sampling where these draws are a large part of every
     step.  Fewer than ``_MIN_BIT_DRAWS`` float32 draws (one sequence, where
     the extra numpy calls cost more than they save) come from
-    ``rng.random`` too.  All are reproducible from ``rng``'s state.
+    ``rng.random`` too.  All are reproducible from ``rng``'s state.  Another
+    namespace's generator (:class:`~sklearn_crbm.utils._array_api.ArrayRandom`)
+    draws with its own ``random``.
     """
+    if not isinstance(rng, np.random.Generator):
+        draws = rng.random(shape, dtype=dtype, out=out)
+        if symmetric:
+            draws *= 2
+            draws -= 1
+        return draws
     dtype = np.dtype(dtype)
     size = math.prod(shape)
     if dtype != np.float32 or size < _MIN_BIT_DRAWS:
@@ -85,11 +95,12 @@ def logistic(activation, out=None):
     overflow ``exp`` to ``inf`` and give exactly 0, very positive ones
     underflow it to 0 and give exactly 1, without a warning.
     """
-    out = np.negative(activation, out=out)
+    ops = array_ops(activation)
+    out = ops.negative(activation, out=out)
     with np.errstate(over="ignore", under="ignore"):
-        np.exp(out, out=out)
+        out = ops.exp(out, out=out)
     out += 1
-    return np.reciprocal(out, out=out)
+    return ops.reciprocal(out, out=out)
 
 
 # Learned visible variances are kept at or above 1e-4 (s >= 0.01, in the units
@@ -219,6 +230,7 @@ class CRBMParameters:
         flat=None,
         layout="C",
         learned_variance=False,
+        ops=np,
     ):
         self.n_features = n_features
         self.learned_variance = learned_variance
@@ -226,10 +238,11 @@ class CRBMParameters:
         self.order = order
         self.hidden_order = hidden_order
         self.visible_type = visible_type
-        self.layout = layout
         shapes = [group.shape(self) for group in GROUPS]
         size = sum(math.prod(shape) for shape in shapes)
-        self.flat = np.zeros(size, dtype) if flat is None else flat
+        self.flat = ops.zeros(size, dtype) if flat is None else flat
+        # Fortran order is numpy's alone (the array API reshapes in C order)
+        self.layout = layout if isinstance(self.flat, np.ndarray) else "C"
         self._bind(shapes)
 
     def _bind(self, shapes=None):
@@ -245,9 +258,11 @@ class CRBMParameters:
             zip(GROUPS, shapes, strict=True), key=lambda pair: not pair[0].decayed
         ):
             size = math.prod(shape)
-            views[group.name] = flat[offset : offset + size].reshape(
-                shape, order=self.layout
-            )
+            part = flat[offset : offset + size]
+            if isinstance(part, np.ndarray):
+                views[group.name] = part.reshape(shape, order=self.layout)
+            else:
+                views[group.name] = array_ops(part).xp.reshape(part, shape)
             offset += size
         return views
 
@@ -260,25 +275,32 @@ class CRBMParameters:
         """``s``, shape ``(n_features,)``; None for unit variance (the fast path)."""
         if not self.learned_variance:
             return None
-        return np.exp(0.5 * self.log_visible_variance)
+        return self.ops.exp(0.5 * self.log_visible_variance)
 
     @property
     def visible_variance(self):
         """``s^2``, shape ``(n_features,)``: ones unless learned (a new array)."""
-        return np.exp(self.log_visible_variance)
+        return self.ops.exp(self.log_visible_variance)
 
     @visible_variance.setter
     def visible_variance(self, value):
-        self.log_visible_variance[...] = np.log(value)
+        self.log_visible_variance[...] = self.ops.log(value)
 
     @property
     def dtype(self):
         return self.flat.dtype
 
     @property
+    def ops(self):
+        """The array functions of :attr:`flat`'s namespace (numpy for numpy)."""
+        return array_ops(self.flat)
+
+    @property
     def decayed(self):
         """The prefix of :attr:`flat` that weight decay applies to."""
-        size = sum(getattr(self, g.name).size for g in GROUPS if g.decayed)
+        size = sum(
+            math.prod(getattr(self, g.name).shape) for g in GROUPS if g.decayed
+        )
         return slice(0, size)
 
     @classmethod
@@ -331,7 +353,22 @@ class CRBMParameters:
             self.dtype,
             layout=self.layout if layout is None else layout,
             learned_variance=self.learned_variance,
+            ops=self.ops,
         )
+
+    def __sklearn_array_api_convert__(self, converter):
+        """The same parameters with :attr:`flat` converted (C order).
+
+        What :func:`sklearn.utils._array_api.move_estimator_to` calls.  The
+        buffer is a copy: a converter may share memory (DLPack on the CPU),
+        and training updates it in place.
+        """
+        source = self if self.layout == "C" else self.copy(layout="C")
+        new = copy.copy(source)
+        new.flat = copy_array(converter(source.flat))
+        new.layout = "C"
+        new._bind()
+        return new
 
     @property
     def autoregressive(self):
@@ -352,13 +389,14 @@ class CRBMParameters:
     def dynamic_mask(self):
         """1 where a directed weight exists, 0 on the lags a group does not use."""
         n = self.n_features
-        mask = np.zeros(self.dynamic.shape, dtype=self.dtype)
+        mask = self.ops.zeros(self.dynamic.shape, dtype=self.dtype)
         mask[:n, : self.order * n] = 1
         mask[n:, : self.hidden_order * n] = 1
         return mask
 
     def is_finite(self):
-        return bool(np.isfinite(self.flat).all())
+        ops = self.ops
+        return bool(ops.all(ops.isfinite(self.flat)))
 
     def __getstate__(self):
         # the views would be pickled as copies: keep the buffer, view it again
@@ -379,6 +417,9 @@ class CRBMParameters:
 
 def _lag_blocks(matrix, q, n):
     """(rows, q * n) -> a (q, rows, n) view; block ``q-1`` is columns ``(q-1)n:qn``."""
+    if not isinstance(matrix, np.ndarray):
+        xp = array_ops(matrix).xp
+        return xp.permute_dims(xp.reshape(matrix, (matrix.shape[0], q, n)), (1, 0, 2))
     blocks = matrix.view()
     blocks.shape = (matrix.shape[0], q, n)  # raises rather than copy
     return blocks.transpose(1, 0, 2)
@@ -404,15 +445,16 @@ def dynamic_biases(params, history, out=None, static=None):
         Views of one array of shape ``(n_frames, n_features + n_components)``.
     """
     n = params.n_features
+    ops = params.ops
     if out is None:
-        out = np.empty((history.shape[0], n + params.n_components), params.dtype)
+        out = ops.empty((history.shape[0], n + params.n_components), params.dtype)
     # one contiguous add is several times faster than two on strided halves
     if static is None:
-        static = np.concatenate((params.visible_bias, params.hidden_bias))
+        static = ops.concatenate((params.visible_bias, params.hidden_bias))
     if params.n_lags == 0:
         out[...] = static
     else:
-        np.matmul(history, params.dynamic.T, out=out)
+        out = ops.matmul(history, params.dynamic.T, out=out)
         out += static
     return out[:, :n], out[:, n:]
 
@@ -456,9 +498,12 @@ def sequence_dynamic_biases(params, X, sequences, frames=None):
 
 def sequence_hidden_probabilities(params, X, sequences):
     """``p(h = 1 | x_t, history)`` of every frame of ``X``, edge padded."""
-    hidden = np.empty((X.shape[0], params.n_components), dtype=X.dtype)
+    ops = params.ops
+    hidden = ops.empty((X.shape[0], params.n_components), dtype=X.dtype)
     for rows, _, hidden_bias in sequence_dynamic_biases(params, X, sequences):
-        hidden[rows] = hidden_probabilities(params, X[rows], hidden_bias)
+        if ops is not np:  # every frame: ranges, basic indexing
+            rows = slice(int(rows[0]), int(rows[-1]) + 1)
+        hidden[rows, ...] = hidden_probabilities(params, X[rows, ...], hidden_bias)
     return hidden
 
 
@@ -470,7 +515,7 @@ def hidden_probabilities(params, visible, hidden_bias, out=None):
     std = params.visible_std
     if std is not None:
         visible = visible / std
-    activation = np.matmul(visible, params.weights.T, out=out)
+    activation = params.ops.matmul(visible, params.weights.T, out=out)
     activation += hidden_bias
     return logistic(activation, out=activation)
 
@@ -480,13 +525,13 @@ def visible_means(params, hidden, visible_bias, out=None):
 
     ``out`` (shape ``(n, n_features)``) receives the result if given.
     """
-    mean = np.matmul(hidden, params.weights, out=out)
+    mean = params.ops.matmul(hidden, params.weights, out=out)
     std = params.visible_std
     if std is not None:
         mean *= std
     mean += visible_bias
     if params.visible_type == BINARY:
-        logistic(mean, out=mean)
+        mean = logistic(mean, out=mean)
     return mean
 
 
@@ -497,7 +542,7 @@ def sample_bernoulli(probabilities, rng, out=None):
     (not ``probabilities`` itself) receives the uniforms, then the states.
     """
     draws = uniform(rng, probabilities.shape, probabilities.dtype, out=out)
-    return np.less(draws, probabilities, out=draws)
+    return array_ops(draws).less(draws, probabilities, out=draws)
 
 
 class HiddenSampler:
@@ -522,14 +567,15 @@ class HiddenSampler:
     """
 
     def __init__(self, params, hidden_bias):
-        self._tanh = params.dtype == np.float32
+        self._ops = ops = params.ops
+        self._tanh = params.dtype == ops.float32
         # a affine map of the activation a: a / 2 (tanh) or -a (exp)
         self._scale = 0.5 if self._tanh else -1.0
         self.weights = params.weights * 0.5 if self._tanh else params.weights
         std = params.visible_std
         if std is not None:  # the hidden input is W (v / s)
             self.weights = self.weights / std
-        self.bias = np.multiply(hidden_bias, self._scale, dtype=params.dtype)
+        self.bias = ops.multiply(hidden_bias, self._scale, dtype=params.dtype)
 
     def __call__(self, visible, rng, out, work, *, hidden_noise=0.0, noise=None):
         """States for ``visible`` (shape ``(n, n_features)``) into ``out``.
@@ -544,23 +590,24 @@ class HiddenSampler:
         ``exp(-a)`` overflows where ``p = 0``, and ``inf * 0`` (``p = 0``,
         ``u = 0``) compares False, as it should.
         """
+        ops = self._ops
         bias = self.bias
         if hidden_noise:
             bias = rng.standard_normal(bias.shape, dtype=bias.dtype, out=noise)
             bias *= self._scale * hidden_noise
             bias += self.bias
-        activation = np.matmul(visible, self.weights.T, out=work)
+        activation = ops.matmul(visible, self.weights.T, out=work)
         if self._tanh:
             activation += bias
-            np.tanh(activation, out=activation)
-            draws = uniform(rng, activation.shape, np.float32, out, symmetric=True)
-            return np.less(draws, activation, out=draws)
-        np.subtract(bias, activation, out=activation)
+            activation = ops.tanh(activation, out=activation)
+            draws = uniform(rng, activation.shape, ops.float32, out, symmetric=True)
+            return ops.less(draws, activation, out=draws)
+        activation = ops.subtract(bias, activation, out=activation)
         draws = uniform(rng, activation.shape, activation.dtype, out=out)
-        np.exp(activation, out=activation)
+        activation = ops.exp(activation, out=activation)
         activation += 1
         activation *= draws
-        return np.less(activation, 1, out=draws)
+        return ops.less(activation, 1, out=draws)
 
 
 def sample_visible_states(params, means, rng, out=None):
@@ -574,29 +621,7 @@ def sample_visible_states(params, means, rng, out=None):
     std = params.visible_std
     if std is not None:
         noise *= std
-    return np.add(means, noise, out=noise)
-
-
-def free_energy(params, visible, visible_bias, hidden_bias):
-    """F(v | history), so that p(v | history) is proportional to exp(-F).
-
-    Gaussian: ``sum_i (v_i - c_hat_i)^2 / (2 s_i^2) - sum_j softplus(b_hat_j +
-    W_j . (v / s))``; binary: ``-c_hat . v - sum_j softplus(b_hat_j + W_j . v)``.
-    """
-    std = params.visible_std
-    scaled = visible if std is None else visible / std
-    activation = scaled @ params.weights.T
-    activation += hidden_bias
-    with np.errstate(under="ignore"):  # softplus(-1e4) = 0 exactly enough
-        softplus = np.logaddexp(0, activation).sum(axis=1)
-    if params.visible_type == GAUSSIAN:
-        residual = visible - visible_bias
-        if std is not None:
-            residual /= std
-        quadratic = 0.5 * np.square(residual).sum(axis=1)
-    else:
-        quadratic = -(visible * visible_bias).sum(axis=1)
-    return quadratic - softplus
+    return params.ops.add(means, noise, out=noise)
 
 
 class CDWorkspace:
@@ -610,27 +635,27 @@ class CDWorkspace:
 
     def __init__(self, params, batch_size):
         n, d, h = batch_size, params.n_features, params.n_components
-        dtype = params.dtype
+        dtype, ops = params.dtype, params.ops
         self.batch_size = batch_size
         # [v; v_recon] and [h_data; h_recon]: the W statistics are one product
-        self.visible_stack = np.empty((2 * n, d), dtype)
-        self.hidden_stack = np.empty((2 * n, h), dtype)
-        self.hidden = np.empty((n, h), dtype)
-        self.biases = np.empty((n, d + h), dtype)
-        self.delta = np.empty((n, d + h), dtype)
-        self.history = np.empty((n, params.n_lags * d), dtype)
-        self.ones = np.ones(n, dtype)
-        self.bias_sums = np.empty(d + h, dtype)
+        self.visible_stack = ops.empty((2 * n, d), dtype)
+        self.hidden_stack = ops.empty((2 * n, h), dtype)
+        self.hidden = ops.empty((n, h), dtype)
+        self.biases = ops.empty((n, d + h), dtype)
+        self.delta = ops.empty((n, d + h), dtype)
+        self.history = ops.empty((n, params.n_lags * d), dtype)
+        self.ones = ops.ones(n, dtype)
+        self.bias_sums = ops.empty(d + h, dtype)
         # s * W.T h of the first reconstruction (learned variances, CD-k > 1)
-        self.first_mean = np.empty((n, d), dtype) if params.learned_variance else None
+        self.first_mean = ops.empty((n, d), dtype) if params.learned_variance else None
         self.dynamic_mask = None
         if params.order != params.hidden_order:
-            self.dynamic_mask = np.zeros_like(params.dynamic)
+            self.dynamic_mask = ops.zeros_like(params.dynamic)
             self.dynamic_mask[...] = params.dynamic_mask()  # in the layout of dynamic
 
     def visible(self, n):
         """Where to gather the visible frames of a minibatch of ``n`` frames."""
-        return self.visible_stack[:n]
+        return self.visible_stack[:n, ...]
 
 
 class MomentumUpdate:
@@ -671,10 +696,11 @@ class MomentumUpdate:
         """Fold :attr:`statistics` into the velocities and those into the parameters."""
         velocity, statistic = self.velocity.flat, self.statistics.flat
         parameters = self.params.flat
+        ops = self.params.ops
         velocity *= momentum
         velocity += statistic
         if weight_decay:  # the statistics are spent: their buffer is scratch
-            decay = np.multiply(
+            decay = ops.multiply(
                 parameters[self._decayed],
                 learning_rate * weight_decay,
                 out=statistic[self._decayed],
@@ -748,36 +774,37 @@ def cd_gradients(
         Sum over the batch of ``||v - v_recon||^2``.
     """
     n, d = visible.shape
+    ops = params.ops
     if workspace is None:
         workspace = CDWorkspace(params, n)
     if out is None:
         out = params.zeros_like()
-    stacked_visible = workspace.visible_stack[: 2 * n]
-    stacked_hidden = workspace.hidden_stack[: 2 * n]
-    data, reconstruction = stacked_visible[:n], stacked_visible[n:]
-    positive_states, negative_probabilities = stacked_hidden[:n], stacked_hidden[n:]
-    if visible.__array_interface__["data"][0] != data.__array_interface__["data"][0]:
-        np.copyto(data, visible)
+    stacked_visible = workspace.visible_stack[: 2 * n, ...]
+    stacked_hidden = workspace.hidden_stack[: 2 * n, ...]
+    data, reconstruction = stacked_visible[:n, ...], stacked_visible[n:, ...]
+    positive_states, negative_probabilities = stacked_hidden[:n, ...], stacked_hidden[n:, ...]
+    if not same_memory(visible, data):
+        ops.copyto(data, visible)
 
     visible_bias, hidden_bias = dynamic_biases(
-        params, history, out=workspace.biases[:n]
+        params, history, out=workspace.biases[:n, ...]
     )
     sample_hidden = HiddenSampler(params, hidden_bias)
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-        sample_hidden(data, rng, out=positive_states, work=workspace.hidden[:n])
+        sample_hidden(data, rng, out=positive_states, work=workspace.hidden[:n, ...])
 
     hidden = positive_states
     learned = params.learned_variance
     for step in range(cd_steps):
         visible_means(params, hidden, visible_bias, out=reconstruction)
         if learned and step == 0:
-            np.subtract(reconstruction, visible_bias, out=workspace.first_mean[:n])
+            ops.subtract(reconstruction, visible_bias, out=workspace.first_mean[:n, ...])
         if step + 1 < cd_steps:
             with np.errstate(over="ignore", under="ignore", invalid="ignore"):
                 hidden = sample_hidden(
                     reconstruction,
                     rng,
-                    out=workspace.hidden[:n],
+                    out=workspace.hidden[:n, ...],
                     work=negative_probabilities,
                 )
         else:
@@ -785,10 +812,12 @@ def cd_gradients(
                 params, reconstruction, hidden_bias, out=negative_probabilities
             )
 
-    delta = workspace.delta[:n]
-    visible_delta = np.subtract(data, reconstruction, out=delta[:, :d])
-    np.subtract(positive_states, negative_probabilities, out=delta[:, d:])
-    squared_error = float(np.einsum("ij,ij->", visible_delta, visible_delta))
+    delta = workspace.delta[:n, ...]
+    visible_delta = ops.subtract(data, reconstruction, out=delta[:, :d])
+    ops.subtract(positive_states, negative_probabilities, out=delta[:, d:])
+    squared_error = ops.einsum("ij,ij->", visible_delta, visible_delta)
+    if ops is np:  # elsewhere a device scalar: no synchronisation per minibatch
+        squared_error = float(squared_error)
 
     if learned:
         _log_variance_statistic(
@@ -796,7 +825,7 @@ def cd_gradients(
             data,
             reconstruction,
             visible_bias,
-            workspace.first_mean[:n],
+            workspace.first_mean[:n, ...],
             scale,
             out=out.log_visible_variance,
         )
@@ -806,14 +835,14 @@ def cd_gradients(
     # statistics are those of v / s
     visible_scale = scale if not learned else scale / params.visible_std
     data *= visible_scale
-    np.multiply(reconstruction, -visible_scale, out=reconstruction)
+    ops.multiply(reconstruction, -visible_scale, out=reconstruction)
     delta *= scale
-    np.matmul(stacked_hidden.T, stacked_visible, out=out.weights)
-    bias_sums = np.dot(workspace.ones[:n], delta, out=workspace.bias_sums)
+    ops.matmul(stacked_hidden.T, stacked_visible, out=out.weights)
+    bias_sums = ops.dot(workspace.ones[:n], delta, out=workspace.bias_sums)
     out.visible_bias[...] = bias_sums[:d]
     out.hidden_bias[...] = bias_sums[d:]
     if params.n_lags:
-        np.matmul(delta.T, history, out=out.dynamic)
+        ops.matmul(delta.T, history, out=out.dynamic)
         if workspace.dynamic_mask is not None:
             out.dynamic *= workspace.dynamic_mask
     return out, squared_error
@@ -823,15 +852,15 @@ def _log_variance_statistic(
     params, data, reconstruction, visible_bias, first, scale, out
 ):
     """``scale`` times the summed CD statistic of ``z = log s^2`` (see cd_gradients)."""
+    ops = params.ops
     last = reconstruction - visible_bias
-    statistic = np.square(data - visible_bias)
+    statistic = ops.square(data - visible_bias)
     statistic += visible_bias * last
     statistic -= data * first
-    total = statistic.sum(axis=0)
+    total = ops.sum(statistic, axis=0)
     total /= 2 * params.visible_variance
-    total -= 0.5 * len(data)
-    np.multiply(total, scale, out=out)
-    return out
+    total -= 0.5 * data.shape[0]
+    return ops.multiply(total, scale, out=out)
 
 
 def gibbs_frames(
@@ -870,13 +899,14 @@ def gibbs_frames(
     frames : ndarray of shape (n, n_features)
     """
     # every step works in these buffers: no allocation inside the loop
-    visible = start.copy()
-    visible_bias = np.ascontiguousarray(visible_bias)
+    ops = params.ops
+    visible = copy_array(start)
+    visible_bias = ops.ascontiguousarray(visible_bias)
     sample_hidden = HiddenSampler(params, hidden_bias)
-    hidden = np.empty_like(sample_hidden.bias)
-    work = np.empty_like(hidden)
-    noise = np.empty_like(hidden) if hidden_noise else None
-    drawn = np.empty_like(visible) if sample_visibles else None
+    hidden = ops.empty_like(sample_hidden.bias)
+    work = ops.empty_like(hidden)
+    noise = ops.empty_like(hidden) if hidden_noise else None
+    drawn = ops.empty_like(visible) if sample_visibles else None
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         for _ in range(n_gibbs):
             sample_hidden(
@@ -889,13 +919,13 @@ def gibbs_frames(
                     visible,
                 )
             if observed_mask is not None:
-                np.copyto(visible, start, where=observed_mask)
+                ops.copyto(visible, start, where=observed_mask)
     if sample_visibles:
         return visible
     hidden_probabilities(params, visible, hidden_bias, out=hidden)
     visible_means(params, hidden, visible_bias, out=visible)
     if observed_mask is not None:
-        np.copyto(visible, start, where=observed_mask)
+        ops.copyto(visible, start, where=observed_mask)
     return visible
 
 
@@ -906,9 +936,9 @@ def mean_field_prediction(params, visible_bias, hidden_bias, n_steps):
     but the model and the history) and alternates hidden probabilities and
     visible means ``n_steps`` times.
     """
-    visible = visible_bias.copy()
+    visible = copy_array(visible_bias)
     if params.visible_type == BINARY:
-        logistic(visible, out=visible)
+        visible = logistic(visible, out=visible)
     for _ in range(n_steps):
         visible = visible_means(
             params, hidden_probabilities(params, visible, hidden_bias), visible_bias
@@ -963,13 +993,14 @@ def stacked_gibbs_frames(
             hidden_noise=hidden_noise,
             observed_mask=observed_mask,
         )
-    visible = start.copy()
+    visible = copy_array(start)
     clamped = None if observed_mask is None else start[observed_mask]
     top = layers[-1]
+    ops = top.ops
     sample_hidden = HiddenSampler(top, hidden_biases[-1])
-    hidden = np.empty_like(sample_hidden.bias)
-    work = np.empty_like(hidden)
-    noise = np.empty_like(hidden) if hidden_noise else None
+    hidden = ops.empty_like(sample_hidden.bias)
+    work = ops.empty_like(hidden)
+    noise = ops.empty_like(hidden) if hidden_noise else None
     for step in range(n_gibbs + 1):
         state = visible
         for params, hidden_bias in zip(layers[:-1], hidden_biases[:-1], strict=True):
@@ -1029,13 +1060,14 @@ def observed_log_likelihood(params, prediction, visible, observed_mask):
     -------
     log_likelihood : ndarray of shape (n,)
     """
+    ops = params.ops
     if params.visible_type == BINARY:
-        eps = np.finfo(prediction.dtype).eps
-        prediction = np.clip(prediction, eps, 1 - eps)
-        terms = np.where(visible > 0.5, np.log(prediction), np.log1p(-prediction))
-        return np.where(observed_mask, terms, 0).sum(axis=1)
-    residual = np.where(observed_mask, visible - prediction, 0)
+        eps = ops.finfo(prediction.dtype).eps
+        prediction = ops.clip(prediction, eps, 1 - eps)
+        terms = ops.where(visible > 0.5, ops.log(prediction), ops.log1p(-prediction))
+        return ops.sum(ops.where(observed_mask, terms, 0), axis=1)
+    residual = ops.where(observed_mask, visible - prediction, 0)
     std = params.visible_std
     if std is not None:
         residual /= std
-    return -0.5 * np.einsum("ij,ij->i", residual, residual)
+    return -0.5 * ops.einsum("ij,ij->i", residual, residual)

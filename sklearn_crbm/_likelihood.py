@@ -51,6 +51,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ._crbm_math import BINARY, logistic
+from .utils._array_api import array_ops, copy_array
 
 # Hidden configurations summed per block by the exact enumeration.
 _EXACT_BLOCK = 4096
@@ -87,13 +88,14 @@ class FrameRBMs:
 
     def __init__(self, params, visible_bias, hidden_bias, scale=None):
         self.binary = params.visible_type == BINARY
-        self.weights = np.asarray(params.weights, dtype=np.float64)
-        self.visible_bias = np.asarray(visible_bias, dtype=np.float64)
-        self.hidden_bias = np.asarray(hidden_bias, dtype=np.float64)
+        self.ops = ops = params.ops
+        self.weights = ops.asarray(params.weights, dtype=ops.float64)
+        self.visible_bias = ops.asarray(visible_bias, dtype=ops.float64)
+        self.hidden_bias = ops.asarray(hidden_bias, dtype=ops.float64)
         n_features = self.weights.shape[1]
         if self.binary or scale is None:
-            scale = np.ones(n_features)
-        self.scale = np.asarray(scale, dtype=np.float64)
+            scale = ops.ones(n_features, dtype=ops.float64)
+        self.scale = ops.asarray(scale, dtype=ops.float64)
 
     @property
     def n_frames(self):
@@ -111,8 +113,12 @@ class FrameRBMs:
         """The RBMs of frames ``rows`` (an index array or a slice)."""
         new = object.__new__(FrameRBMs)
         new.__dict__.update(self.__dict__)
-        new.visible_bias = self.visible_bias[rows]
-        new.hidden_bias = self.hidden_bias[rows]
+        if isinstance(rows, slice):
+            new.visible_bias = self.visible_bias[rows, ...]
+            new.hidden_bias = self.hidden_bias[rows, ...]
+        else:
+            new.visible_bias = self.ops.take(self.visible_bias, rows, axis=0)
+            new.hidden_bias = self.ops.take(self.hidden_bias, rows, axis=0)
         return new
 
     def hidden_input(self, visible, hidden_bias=None):
@@ -122,18 +128,22 @@ class FrameRBMs:
 
     def negative_free_energy(self, visible):
         """``-F(v)`` of every frame's own row of ``visible``."""
-        softplus = np.logaddexp(0, self.hidden_input(visible)).sum(axis=1)
+        ops = self.ops
+        softplus = ops.sum(ops.logaddexp(0, self.hidden_input(visible)), axis=1)
         if self.binary:
-            return np.einsum("ij,ij->i", visible, self.visible_bias) + softplus
+            return ops.einsum("ij,ij->i", visible, self.visible_bias) + softplus
         residual = (visible - self.visible_bias) / self.scale
-        return softplus - 0.5 * np.einsum("ij,ij->i", residual, residual)
+        return softplus - 0.5 * ops.einsum("ij,ij->i", residual, residual)
 
     def gaussian_normaliser(self):
         """``sum_i log(sqrt(2 pi) s_i)``: the visible integral's constant."""
         return (
             0.0
             if self.binary
-            else float(np.sum(np.log(self.scale)) + (self.n_features * _LOG_SQRT_2PI))
+            else float(
+                self.ops.sum(self.ops.log(self.scale))
+                + (self.n_features * _LOG_SQRT_2PI)
+            )
         )
 
 
@@ -163,11 +173,11 @@ class LogLikelihood(NamedTuple):
 # ------------------------------------------------------------------ exact
 
 
-def hidden_configurations(n_components, start, stop):
+def hidden_configurations(n_components, start, stop, ops=np):
     """Rows ``start`` to ``stop`` of all binary vectors of length ``n_components``."""
-    codes = np.arange(start, stop, dtype=np.int64)[:, None]
-    bits = np.arange(n_components, dtype=np.int64)
-    return ((codes >> bits) & 1).astype(np.float64)
+    codes = ops.arange(start, stop, dtype=ops.int64)[:, None]
+    bits = ops.arange(n_components, dtype=ops.int64)
+    return ops.astype((codes >> bits) & 1, ops.float64)
 
 
 def log_partition_exact(rbms):
@@ -192,23 +202,27 @@ def log_partition_exact(rbms):
     block = _EXACT_BLOCK
     if rbms.binary:  # the softplus term is (frames, block, features)
         block = max(1, min(block, (1 << 22) // max(1, rbms.n_frames * rbms.n_features)))
-    log_z = np.full(rbms.n_frames, -np.inf)
+    ops = rbms.ops
+    log_z = ops.full(rbms.n_frames, -math.inf, dtype=ops.float64)
     for start in range(0, total, block):
-        hidden = hidden_configurations(n_components, start, min(start + block, total))
+        stop = min(start + block, total)
+        hidden = hidden_configurations(n_components, start, stop, ops)
         u = hidden @ rbms.weights  # (configs, n_features)
         terms = rbms.hidden_bias @ hidden.T
         if rbms.binary:
-            terms += np.logaddexp(0, rbms.visible_bias[:, None, :] + u).sum(axis=2)
+            softplus = ops.logaddexp(0, rbms.visible_bias[:, None, :] + u)
+            terms += ops.sum(softplus, axis=2)
         else:
             terms += (rbms.visible_bias / rbms.scale) @ u.T
-            terms += 0.5 * np.einsum("ij,ij->i", u, u)
-        log_z = np.logaddexp(log_z, _logsumexp_rows(terms))
+            terms += 0.5 * ops.einsum("ij,ij->i", u, u)
+        log_z = ops.logaddexp(log_z, _logsumexp_rows(terms))
     return log_z + rbms.gaussian_normaliser()
 
 
 def _logsumexp_rows(values):
-    top = values.max(axis=1)
-    return top + np.log(np.exp(values - top[:, None]).sum(axis=1))
+    ops = array_ops(values)
+    top = ops.max(values, axis=1)
+    return top + ops.log(ops.sum(ops.exp(values - top[:, None]), axis=1))
 
 
 def exact_is_cheaper(n_components, n_features, n_steps, n_chains):
@@ -235,9 +249,12 @@ def mean_field_base(rbms, start=None, n_steps=_MEAN_FIELD_STEPS):
         Gaussian: the base mean ``m``; binary: the base logits.
     hidden_logits : ndarray of shape (n_frames, n_components)
     """
-    field = rbms.visible_bias.copy()
+    ops = rbms.ops
+    field = copy_array(rbms.visible_bias)
     if start is not None:
-        field = _logit(start) if rbms.binary else np.array(start, dtype=np.float64)
+        field = (
+            _logit(start) if rbms.binary else ops.astype(start, ops.float64, copy=True)
+        )
     hidden = None
     for _ in range(n_steps):
         visible = logistic(field) if rbms.binary else field
@@ -249,8 +266,9 @@ def mean_field_base(rbms, start=None, n_steps=_MEAN_FIELD_STEPS):
 
 
 def _logit(probability):
-    p = np.clip(probability, _BASE_CLIP, 1 - _BASE_CLIP)
-    return np.log(p) - np.log1p(-p)
+    ops = array_ops(probability)
+    p = ops.clip(probability, _BASE_CLIP, 1 - _BASE_CLIP)
+    return ops.log(p) - ops.log1p(-p)
 
 
 class _Annealing:
@@ -267,16 +285,20 @@ class _Annealing:
     ``(c_hat - logit(m)) . v``).
     """
 
-    dtype = np.float32
-
     def __init__(self, rbms, n_chains, start=None):
+        self.ops = ops = rbms.ops
+        self.dtype = ops.float32
         visible_base, hidden_logits = mean_field_base(rbms, start)
         rows = np.repeat(np.arange(rbms.n_frames), n_chains)
         self.binary = rbms.binary
         self.n_rows = len(rows)
-        self.log_base_normaliser = np.logaddexp(0, hidden_logits).sum(axis=1)[rows]
+        self.log_base_normaliser = ops.take(
+            ops.sum(ops.logaddexp(0, hidden_logits), axis=1), rows
+        )
         if rbms.binary:
-            self.log_base_normaliser += np.logaddexp(0, visible_base).sum(axis=1)[rows]
+            self.log_base_normaliser += ops.take(
+                ops.sum(ops.logaddexp(0, visible_base), axis=1), rows
+            )
         else:
             self.log_base_normaliser += rbms.gaussian_normaliser()
         scale = rbms.scale
@@ -285,32 +307,32 @@ class _Annealing:
         offset = 0.0
         if not rbms.binary:
             middle = 0.5 * (rbms.visible_bias + visible_base)
-            offset = np.einsum("ij,ij->i", gradient, middle)[rows]
+            offset = ops.take(ops.einsum("ij,ij->i", gradient, middle), rows)
         self.change_offset = offset
 
         def rows_of(array):
-            return np.ascontiguousarray(array[rows], dtype=self.dtype)
+            return ops.ascontiguousarray(ops.take(array, rows, axis=0), self.dtype)
 
-        self.scale = scale.astype(self.dtype)
+        self.scale = ops.astype(scale, self.dtype)
         self.visible_base = rows_of(visible_base)
         self.shift = rows_of(shift)
         self.gradient = rows_of(gradient)
         self.hidden_logits = rows_of(hidden_logits)
         self.input_offset = rows_of(rbms.hidden_bias - hidden_logits)  # b_hat - a
-        self.input_weights = np.ascontiguousarray((rbms.weights / scale).T, self.dtype)
-        self.field_weights = np.ascontiguousarray(rbms.weights * scale, self.dtype)
+        self.input_weights = ops.ascontiguousarray((rbms.weights / scale).T, self.dtype)
+        self.field_weights = ops.ascontiguousarray(rbms.weights * scale, self.dtype)
         n_hidden = rbms.n_components
-        self.difference = np.empty((self.n_rows, n_hidden), self.dtype)
-        self.logits = np.empty_like(self.difference)
-        self.previous = np.empty_like(self.difference)
-        self.work = np.empty_like(self.difference)
+        self.difference = ops.empty((self.n_rows, n_hidden), self.dtype)
+        self.logits = ops.empty_like(self.difference)
+        self.previous = ops.empty_like(self.difference)
+        self.work = ops.empty_like(self.difference)
 
     def sample_base(self, rng):
         if self.binary:
-            return _bernoulli(logistic(self.visible_base.copy()), rng)
+            return _bernoulli(logistic(copy_array(self.visible_base)), rng)
         noise = rng.standard_normal(self.visible_base.shape, dtype=self.dtype)
         noise *= self.scale
-        return np.add(self.visible_base, noise, out=noise)
+        return self.ops.add(self.visible_base, noise, out=noise)
 
     def step(self, visible, beta, previous_beta):
         """``log f_beta(v) - log f_previous(v)`` of every row (float64).
@@ -318,24 +340,25 @@ class _Annealing:
         Leaves the hidden logits at both temperatures in :attr:`logits`
         (``beta``) and :attr:`previous` (``previous_beta``).
         """
-        difference = np.matmul(visible, self.input_weights, out=self.difference)
+        ops = self.ops
+        difference = ops.matmul(visible, self.input_weights, out=self.difference)
         difference += self.input_offset
-        logits = np.multiply(difference, beta, out=self.logits)
+        logits = ops.multiply(difference, beta, out=self.logits)
         logits += self.hidden_logits
-        previous = np.multiply(difference, previous_beta - beta, out=self.previous)
+        previous = ops.multiply(difference, previous_beta - beta, out=self.previous)
         previous += logits
         hidden = _softplus(logits, self.work)
         hidden -= _softplus(previous, self.difference)
-        change = np.einsum("ij,ij->i", visible, self.gradient, dtype=np.float64)
+        change = ops.einsum("ij,ij->i", visible, self.gradient, dtype=ops.float64)
         change -= self.change_offset
         change *= beta - previous_beta
-        change += hidden.sum(axis=1, dtype=np.float64)
+        change += ops.sum(hidden, axis=1, dtype=ops.float64)
         return change
 
     def gibbs(self, beta, logits, rng):
         """A block-Gibbs step at ``beta`` from hidden logits ``a + beta d(v)``."""
         hidden = _bernoulli(logistic(logits, out=self.work), rng)
-        field = np.matmul(hidden, self.field_weights)
+        field = self.ops.matmul(hidden, self.field_weights)
         field += self.shift
         field *= beta
         field += self.visible_base
@@ -349,17 +372,19 @@ class _Annealing:
 
 def _softplus(x, out):
     """``log(1 + exp(x))`` elementwise into ``out`` (not ``x``)."""
-    np.abs(x, out=out)
-    np.negative(out, out=out)
-    np.exp(out, out=out)
-    np.log1p(out, out=out)
-    out += np.maximum(x, 0)
+    ops = array_ops(x)
+    out = ops.abs(x, out=out)
+    out = ops.negative(out, out=out)
+    out = ops.exp(out, out=out)
+    out = ops.log1p(out, out=out)
+    out += ops.maximum(x, 0)
     return out
 
 
 def _bernoulli(probability, rng):
+    ops = array_ops(probability)
     draws = rng.random(probability.shape, dtype=probability.dtype)
-    return np.less(draws, probability).astype(probability.dtype)
+    return ops.astype(ops.less(draws, probability), probability.dtype)
 
 
 def annealing_schedule(n_steps):
@@ -377,6 +402,12 @@ def annealing_schedule(n_steps):
             np.linspace(0.75, 1.0, n_steps - first + 1),
         )
     )
+
+
+def _schedule(n_steps, ops):
+    """:func:`annealing_schedule`: numpy scalars for numpy, Python floats elsewhere."""
+    betas = annealing_schedule(n_steps)
+    return betas if ops is np else betas.tolist()
 
 
 def log_partition_ais(rbms, n_steps, n_chains, rng):
@@ -398,8 +429,9 @@ def log_partition_ais(rbms, n_steps, n_chains, rng):
     standard_error : ndarray of shape (n_frames,)
         Delta-method standard error of ``log_z`` across chains.
     """
-    log_z = np.empty(rbms.n_frames)
-    error = np.empty(rbms.n_frames)
+    ops = rbms.ops
+    log_z = ops.empty(rbms.n_frames, dtype=ops.float64)
+    error = ops.empty(rbms.n_frames, dtype=ops.float64)
     for rows in _row_blocks(rbms.n_frames, n_chains):
         log_weights = _forward_log_weights(rbms.take(rows), n_steps, n_chains, rng)
         log_z[rows], error[rows] = _log_mean_exp(log_weights)
@@ -427,25 +459,28 @@ def shared_log_partition_ais(rbms, starts, n_steps, n_chains, rng):
     log_z : float
     standard_error : float
     """
-    rbms = rbms.take(np.zeros(len(starts), dtype=np.intp))
+    ops = rbms.ops
+    rbms = rbms.take(np.zeros(starts.shape[0], dtype=np.intp))
     log_weights = [
-        _forward_log_weights(rbms.take(rows), n_steps, n_chains, rng, starts[rows])
-        for rows in _row_blocks(len(starts), n_chains)
+        _forward_log_weights(
+            rbms.take(rows), n_steps, n_chains, rng, starts[rows, ...]
+        )
+        for rows in _row_blocks(starts.shape[0], n_chains)
     ]
-    log_z, error = _log_mean_exp(np.concatenate(log_weights).reshape(1, -1))
+    log_z, error = _log_mean_exp(ops.reshape(ops.concatenate(log_weights), (1, -1)))
     return float(log_z[0]), float(error[0])
 
 
 def _forward_log_weights(rbms, n_steps, n_chains, rng, start=None):
     path = _Annealing(rbms, n_chains, start)
-    betas = annealing_schedule(n_steps)
+    betas = _schedule(n_steps, rbms.ops)
     visible = path.sample_base(rng)
-    log_weight = path.log_base_normaliser.copy()
+    log_weight = copy_array(path.log_base_normaliser)
     for k in range(1, len(betas)):
         log_weight += path.step(visible, betas[k], betas[k - 1])
         if k < len(betas) - 1:
             visible = path.gibbs(betas[k], path.logits, rng)
-    return log_weight.reshape(rbms.n_frames, n_chains)
+    return rbms.ops.reshape(log_weight, (rbms.n_frames, n_chains))
 
 
 def log_likelihood_raise(rbms, visible, n_steps, n_chains, rng):
@@ -461,27 +496,28 @@ def log_likelihood_raise(rbms, visible, n_steps, n_chains, rng):
     -------
     log_likelihood : ndarray of shape (n_frames,)
     """
-    result = np.empty(rbms.n_frames)
+    result = rbms.ops.empty(rbms.n_frames, dtype=rbms.ops.float64)
     for rows in _row_blocks(rbms.n_frames, n_chains):
         result[rows] = _reverse_log_likelihood(
-            rbms.take(rows), visible[rows], n_steps, n_chains, rng
+            rbms.take(rows), visible[rows, ...], n_steps, n_chains, rng
         )
     return result
 
 
 def _reverse_log_likelihood(rbms, visible, n_steps, n_chains, rng):
+    ops = rbms.ops
     path = _Annealing(rbms, n_chains)
-    betas = annealing_schedule(n_steps)
-    start = np.repeat(rbms.negative_free_energy(visible), n_chains)
+    betas = _schedule(n_steps, rbms.ops)
+    start = ops.repeat(rbms.negative_free_energy(visible), n_chains)
     log_weight = start - path.log_base_normaliser
-    state = np.repeat(visible, n_chains, axis=0).astype(path.dtype)
+    state = ops.astype(ops.repeat(visible, n_chains, axis=0), path.dtype)
     path.step(state, betas[-1], betas[-2])  # the hidden logits at beta = 1
     logits = path.logits
     for k in range(len(betas) - 1, 0, -1):
         state = path.gibbs(betas[k], logits, rng)
         log_weight -= path.step(state, betas[k], betas[k - 1])
         logits = path.previous
-    return _log_mean_exp(log_weight.reshape(rbms.n_frames, n_chains))[0]
+    return _log_mean_exp(ops.reshape(log_weight, (rbms.n_frames, n_chains)))[0]
 
 
 def _row_blocks(n_frames, n_chains):
@@ -492,12 +528,13 @@ def _row_blocks(n_frames, n_chains):
 
 def _log_mean_exp(log_weights):
     """``log mean exp`` over axis 1, and its delta-method standard error."""
-    top = log_weights.max(axis=1, keepdims=True)
-    weights = np.exp(log_weights - top)
-    mean = weights.mean(axis=1)
+    ops = array_ops(log_weights)
+    top = ops.max(log_weights, axis=1, keepdims=True)
+    weights = ops.exp(log_weights - top)
+    mean = ops.mean(weights, axis=1)
     n = log_weights.shape[1]
-    spread = weights.std(axis=1, ddof=1) if n > 1 else np.zeros(len(mean))
-    return top[:, 0] + np.log(mean), spread / (math.sqrt(n) * mean)
+    spread = ops.std(weights, axis=1, ddof=1) if n > 1 else ops.zeros_like(mean)
+    return top[:, 0] + ops.log(mean), spread / (math.sqrt(n) * mean)
 
 
 # ----------------------------------------------------------------- public
@@ -515,19 +552,17 @@ def log_partition(rbms, *, method, n_steps, n_chains, rng):
         )
         method = "exact" if cheaper else "ais"
     if method == "exact":
-        return log_partition_exact(rbms), np.zeros(rbms.n_frames), "exact"
+        log_z = log_partition_exact(rbms)
+        return log_z, rbms.ops.zeros_like(log_z), "exact"
     return (*log_partition_ais(rbms, n_steps, n_chains, rng), "ais")
 
 
 def _shared_log_partition(rbms, frames, method, n_steps, n_chains, rng):
     """``log Z``, its standard error and the method, for a model without history."""
-    starts = frames[
-        np.unique(np.linspace(0, len(frames) - 1, SHARED_STARTS).round()).astype(
-            np.intp
-        )
-    ]
+    picks = np.unique(np.linspace(0, frames.shape[0] - 1, SHARED_STARTS).round())
+    starts = rbms.ops.take(frames, picks.astype(np.intp), axis=0)
     n_steps *= SHARED_STEPS
-    n_chains_total = n_chains * len(starts)
+    n_chains_total = n_chains * starts.shape[0]
     one = rbms.take(slice(0, 1))
     if method == "auto":
         cheaper = exact_is_cheaper(
@@ -535,7 +570,7 @@ def _shared_log_partition(rbms, frames, method, n_steps, n_chains, rng):
         )
         method = "exact" if cheaper else "ais"
     if method == "exact":
-        return log_partition_exact(one)[0], 0.0, "exact"
+        return float(log_partition_exact(one)[0]), 0.0, "exact"
     return (*shared_log_partition_ais(one, starts, n_steps, n_chains, rng), "ais")
 
 
@@ -579,14 +614,15 @@ def frame_log_likelihood(
     LogLikelihood
     """
     rng = np.random.default_rng() if rng is None else rng
+    ops = params.ops
     with np.errstate(under="ignore"):  # exp of very negative numbers is 0
         parts = _chunk_log_likelihoods(
             params, scale, visible, chunks, method, n_steps, n_chains, reverse, rng
         )
     return LogLikelihood(
-        np.concatenate([p[0] for p in parts]),
-        np.concatenate([p[1] for p in parts]) if reverse else None,
-        np.concatenate([p[2] for p in parts]),
+        ops.concatenate([p[0] for p in parts]),
+        ops.concatenate([p[1] for p in parts]) if reverse else None,
+        ops.concatenate([p[2] for p in parts]),
         parts[0][3] if parts else "exact",
     )
 
@@ -608,14 +644,16 @@ def _chunk_log_likelihoods(
             log_z, error, used = log_partition(
                 rbms, method=method, n_steps=n_steps, n_chains=n_chains, rng=rng
             )
-        frames = visible[rows].astype(np.float64)
+        ops = rbms.ops
+        frames = ops.astype(ops.take(visible, rows, axis=0), ops.float64)
         log_likelihood = rbms.negative_free_energy(frames) - log_z
         lower = None
         if reverse:
             lower = log_likelihood
             if used == "ais":
                 lower = log_likelihood_raise(rbms, frames, n_steps, n_chains, rng)
-        parts.append((log_likelihood, lower, np.broadcast_to(error, len(rows)), used))
+        error = ops.broadcast_to(ops.asarray(error, dtype=ops.float64), (len(rows),))
+        parts.append((log_likelihood, lower, error, used))
     return parts
 
 
@@ -657,32 +695,44 @@ def stack_log_likelihood_bound(layers, visible, biases, *, n_samples, rng, **top
     -------
     bound : ndarray of shape (n_frames,)
     """
-    n_frames = len(visible)
+    n_frames = visible.shape[0]
+    ops = array_ops(visible)
     rows = np.repeat(np.arange(n_frames), n_samples)
-    state = visible[rows].astype(np.float64)
-    log_weight = np.zeros(len(rows))
+    state = ops.astype(ops.take(visible, rows, axis=0), ops.float64)
+    log_weight = ops.zeros(len(rows), dtype=ops.float64)
     with np.errstate(under="ignore"):
         for (params, scale), (visible_bias, hidden_bias) in zip(
             layers[:-1], biases[:-1], strict=True
         ):
-            rbms = FrameRBMs(params, visible_bias[rows], hidden_bias[rows], scale)
+            rbms = FrameRBMs(
+                params,
+                ops.take(visible_bias, rows, axis=0),
+                ops.take(hidden_bias, rows, axis=0),
+                scale,
+            )
             logits = rbms.hidden_input(state)
-            hidden = _bernoulli(logistic(logits.copy()), rng)
-            log_weight -= np.sum(hidden * logits - np.logaddexp(0, logits), axis=1)
+            hidden = _bernoulli(logistic(copy_array(logits)), rng)
+            log_weight -= ops.sum(
+                hidden * logits - ops.logaddexp(0, logits), axis=1
+            )
             log_weight += _log_visible_given_hidden(rbms, state, hidden)
             state = hidden
         params, scale = layers[-1]
         top_rbms = FrameRBMs(params, *biases[-1], scale)
         log_z, _, _ = log_partition(top_rbms, rng=rng, **top)
-        log_weight += top_rbms.take(rows).negative_free_energy(state) - log_z[rows]
-    return _log_mean_exp(log_weight.reshape(n_frames, n_samples))[0]
+        top_term = top_rbms.take(rows).negative_free_energy(state)
+        log_weight += top_term - ops.take(log_z, rows)
+    return _log_mean_exp(ops.reshape(log_weight, (n_frames, n_samples)))[0]
 
 
 def _log_visible_given_hidden(rbms, visible, hidden):
     """``log p(v | h)`` per row: ``N(c_hat + s W.T h, s^2)`` or Bernoulli."""
+    ops = rbms.ops
     field = hidden @ rbms.weights
     if rbms.binary:
         field += rbms.visible_bias
-        return np.sum(visible * field - np.logaddexp(0, field), axis=1)
+        return ops.sum(visible * field - ops.logaddexp(0, field), axis=1)
     residual = (visible - rbms.visible_bias) / rbms.scale - field
-    return -0.5 * np.einsum("ij,ij->i", residual, residual) - rbms.gaussian_normaliser()
+    return (
+        -0.5 * ops.einsum("ij,ij->i", residual, residual) - rbms.gaussian_normaliser()
+    )

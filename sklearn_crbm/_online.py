@@ -28,6 +28,7 @@ from ._crbm_math import (
     stacked_prediction,
     visible_means,
 )
+from .utils._array_api import array_ops, copy_array
 from .utils._sequences import Sequences
 
 # How a stack draws a frame (``scheme`` of run_online).  With one layer the two
@@ -67,8 +68,11 @@ class History:
     def __init__(self, layers, windows):
         self.layers = layers
         self.windows = windows
+        self._ops = layers[0].ops
         # the static biases of a model that does not change while it runs
-        self._static = [np.concatenate((p.visible_bias, p.hidden_bias)) for p in layers]
+        self._static = [
+            self._ops.concatenate((p.visible_bias, p.hidden_bias)) for p in layers
+        ]
 
     @classmethod
     def from_frames(cls, layers, frames):
@@ -85,36 +89,40 @@ class History:
             longer than what a layer keeps repeats the oldest kept value.
         """
         n_chains, n_sequences = frames.shape[:2]
+        ops = layers[0].ops
         windows = []
         values = frames
         for k, params in enumerate(layers):
             n_frames = values.shape[2]
             n_slots = max(params.n_lags, 1)
             picks = np.maximum(np.arange(n_frames - 1, n_frames - 1 - n_slots, -1), 0)
-            windows.append(np.ascontiguousarray(values[:, :, picks]))
+            windows.append(ops.ascontiguousarray(ops.take(values, picks, axis=2)))
             if k + 1 < len(layers):
-                flat = values.reshape(-1, values.shape[3])
+                flat = ops.reshape(values, (-1, values.shape[3]))
                 lengths = np.full(n_chains * n_sequences, n_frames, dtype=np.intp)
                 sequences = Sequences(
-                    starts=np.arange(0, len(flat), n_frames, dtype=np.intp),
+                    starts=np.arange(0, flat.shape[0], n_frames, dtype=np.intp),
                     lengths=lengths,
                     ids=np.arange(len(lengths)),
                 )
                 hidden = sequence_hidden_probabilities(params, flat, sequences)
-                hidden = hidden.reshape(n_chains, n_sequences, n_frames, -1)
-                values = hidden[:, :, min(params.n_lags, n_frames - 1) :]
+                hidden = ops.reshape(hidden, (n_chains, n_sequences, n_frames, -1))
+                values = hidden[:, :, min(params.n_lags, n_frames - 1) :, ...]
         return cls(layers, windows)
 
     def select(self, sequences):
         """The past of some sequences only (for a block of work)."""
-        return History(self.layers, [w[:, sequences] for w in self.windows])
+        ops = self._ops
+        return History(
+            self.layers, [ops.take(w, sequences, axis=1) for w in self.windows]
+        )
 
     def previous(self, level, sequences):
         """The last values at ``level`` of ``sequences``: (n_chains, n, n_visible).
 
         ``sequences`` (here and below) is an index array, or a slice.
         """
-        return self.windows[level][:, sequences, 0]
+        return self.windows[level][:, sequences, 0, ...]
 
     def biases(self, sequences):
         """Every layer's dynamic biases for the next frame of ``sequences``.
@@ -126,12 +134,14 @@ class History:
         for params, window, static in zip(
             self.layers, self.windows, self._static, strict=True
         ):
-            past = window[:, sequences]
+            ops = self._ops
+            past = window[:, sequences, ...]
             n_chains, n_rows = past.shape[:2]
-            flat = past.reshape(n_chains * n_rows, -1)
+            flat = ops.reshape(past, (n_chains * n_rows, -1))
             flat = flat[:, : params.n_lags * params.n_features]
-            both = np.empty((n_chains, n_rows, len(static)), params.dtype)
-            dynamic_biases(params, flat, out=both.reshape(len(flat), -1), static=static)
+            both = ops.empty((n_chains, n_rows, static.shape[0]), params.dtype)
+            rows = ops.reshape(both, (flat.shape[0], -1))
+            dynamic_biases(params, flat, out=rows, static=static)
             biases.append(both)
         return biases
 
@@ -143,6 +153,7 @@ class History:
         probabilities of the layer below, given ``biases`` (from
         :meth:`biases` for this frame).
         """
+        ops = self._ops
         if len(values) < len(self.layers):
             values = list(values)
         for k in range(len(values), len(self.layers)):
@@ -151,13 +162,14 @@ class History:
             hidden_bias = biases[k - 1][..., params.n_features :]
             flat = hidden_probabilities(
                 params,
-                below.reshape(-1, params.n_features),
-                hidden_bias.reshape(-1, params.n_components),
+                ops.reshape(below, (-1, params.n_features)),
+                ops.reshape(hidden_bias, (-1, params.n_components)),
             )
-            values.append(flat.reshape(*below.shape[:2], -1))
+            values.append(ops.reshape(flat, (*below.shape[:2], -1)))
         for window, value in zip(self.windows, values, strict=True):
-            window[:, sequences, 1:] = window[:, sequences, :-1]
-            window[:, sequences, 0] = value
+            # a copy: the array API leaves overlapping assignment undefined
+            window[:, sequences, 1:, ...] = copy_array(window[:, sequences, :-1, ...])
+            window[:, sequences, 0, ...] = value
 
     def reorder(self, chains, sequences):
         """Give chain ``i`` of each of ``sequences`` the past of chain ``chains[i]``.
@@ -187,6 +199,53 @@ class Observed:
     sequences: Sequences
 
 
+class Offsets:
+    """Each chain's systematic one-step error per sequence and channel.
+
+    A model that fills a sequence from its own past drifts towards its own
+    typical values (a slow posture channel towards the training posture);
+    while a channel is observed, its one-step residual ``r_t = x_t -
+    x_hat_t`` (``x_hat_t`` the chain's mean-field prediction of the frame
+    from its past, :func:`~sklearn_crbm._crbm_math.stacked_prediction`)
+    shows that error.  The correction of a missing entry is the posterior
+    mean of a constant offset ``d`` behind the residuals, ``r_t = d +
+    noise``, with a prior worth ``shrinkage`` frames of zero residual:
+    ``sum(r) / (n + shrinkage)`` over the ``n`` frames of the sequence in
+    which the channel was observed so far (counted from the model's order
+    on: earlier frames have an edge-padded past).
+
+    Parameters
+    ----------
+    n_chains, n_sequences, n_features : int
+    dtype : dtype
+    shrinkage : float
+    """
+
+    def __init__(self, n_chains, n_sequences, n_features, dtype, shrinkage):
+        self.sums = np.zeros((n_chains, n_sequences, n_features), dtype)
+        self.counts = np.zeros((n_sequences, n_features), dtype)
+        self.shrinkage = shrinkage
+
+    def update(self, layers, biases, sequences, frames, observed):
+        """Add the residuals of ``frames`` (one per sequence) where ``observed``."""
+        n_chains = self.sums.shape[0]
+        prediction = stacked_prediction(
+            layers, *_split(layers, biases), PREDICTION_STEPS
+        ).reshape(n_chains, *frames.shape)
+        self.sums[:, sequences] += np.where(observed, frames - prediction, 0)
+        self.counts[sequences] += observed
+
+    def correction(self, sequences, missing):
+        """What to add to each chain's fill of ``sequences``: 0 where observed."""
+        # a channel never observed has a zero sum; the floor spares 0 / 0
+        denominator = np.maximum(self.counts[sequences] + self.shrinkage, 1)
+        return np.where(missing, self.sums[:, sequences] / denominator, 0)
+
+    def reorder(self, chains, sequences):
+        """The chains' offsets follow their pasts (:meth:`History.reorder`)."""
+        self.sums[:, sequences] = self.sums[chains, sequences[None, :]]
+
+
 def run_online(
     layers,
     rng,
@@ -201,6 +260,7 @@ def run_online(
     start_jitter=0.0,
     hidden_noise=0.0,
     sample_visibles=False,
+    offset_shrinkage=None,
 ):
     """Draw frames one after another, each given the chains' own past.
 
@@ -247,6 +307,11 @@ def run_online(
     sample_visibles : bool, default=False
         Draw the visibles at every step (:func:`gibbs_frames`); one layer,
         or the top layer with :data:`TOP_LAYER`.
+    offset_shrinkage : float, default=None
+        Fill-in only.  ``None``: no correction.  A number ``lam >= 0``: each
+        chain's drawn entries are shifted by the chain's
+        :class:`Offsets` correction (its mean one-step residual of that
+        channel in that sequence so far, shrunk by ``lam`` frames).
 
     Yields
     ------
@@ -270,8 +335,8 @@ def run_online(
         """One Gibbs run per (chain, frame) pair; the frame's lowest values."""
         shape = start.shape
         visible_biases, hidden_biases = _split(layers, biases)
-        start = start.reshape(-1, shape[-1])
-        clamp = None if clamp is None else clamp.reshape(-1, shape[-1])
+        start = ops.reshape(start, (-1, shape[-1]))
+        clamp = None if clamp is None else ops.reshape(clamp, (-1, shape[-1]))
         if stacked and scheme == WHOLE_STACK:
             frame = stacked_gibbs_frames(
                 layers,
@@ -283,7 +348,7 @@ def run_online(
                 hidden_noise=hidden_noise,
                 observed_mask=clamp,
             )
-            return [frame.reshape(shape)]
+            return [ops.reshape(frame, shape)]
         values = [
             gibbs_frames(
                 layers[-1],
@@ -300,8 +365,9 @@ def run_online(
         below = zip(layers[-2::-1], visible_biases[-2::-1], strict=True)
         for params, visible_bias in below:
             values.insert(0, visible_means(params, values[0], visible_bias))
-        return [v.reshape(*shape[:2], -1) for v in values]
+        return [ops.reshape(v, (*shape[:2], -1)) for v in values]
 
+    ops = layers[0].ops
     level = len(layers) - 1 if scheme == TOP_LAYER else 0
     if observed is None:
         sequences = np.arange(history.windows[0].shape[1])
@@ -322,6 +388,9 @@ def run_online(
     starts, lengths = all_sequences.starts, all_sequences.lengths
     n_features = X.shape[1]
     n_steps = int(lengths.max(initial=0)) if n_steps is None else n_steps
+    offsets = None
+    if offset_shrinkage is not None:
+        offsets = Offsets(n_chains, len(starts), n_features, X.dtype, offset_shrinkage)
     for step in range(n_steps):
         sequences = np.flatnonzero(lengths > step)
         rows = starts[sequences] + step
@@ -344,7 +413,7 @@ def run_online(
             yield step, sequences, drawn, current[:, drawn]
             continue
         if n_particles > 1 and len(drawn):
-            _resample(
+            chains = _resample(
                 history,
                 sequences[drawn],
                 frames[drawn],
@@ -352,7 +421,11 @@ def run_online(
                 n_particles,
                 rng,
             )
+            if offsets is not None:
+                offsets.reorder(chains, sequences[drawn])
         biases = history.biases(sequences)
+        if offsets is not None and step >= layers[0].n_lags:
+            offsets.update(layers, biases, sequences, frames, ~frame_missing)
         if len(drawn):
             start = np.where(
                 frame_missing[drawn],
@@ -362,6 +435,10 @@ def run_online(
             if start_jitter:
                 start += start_jitter * rng.standard_normal(start.shape, start.dtype)
             current[:, drawn] = draw(start, [b[:, drawn] for b in biases], clamp)[0]
+            if offsets is not None:
+                current[:, drawn] += offsets.correction(
+                    sequences[drawn], frame_missing[drawn]
+                )
         yield step, sequences, drawn, current[:, drawn]
         history.push([current], sequences, biases)
 
@@ -373,7 +450,8 @@ def _resample(history, sequences, frames, observed, n_particles, rng):
     under its own one-step prediction
     (:func:`~sklearn_crbm._crbm_math.observed_log_likelihood`); each group is
     resampled (systematic resampling) and the pasts of the chosen ancestors
-    copied, before the frame is drawn.
+    copied, before the frame is drawn.  Returns the ancestors, as
+    :meth:`History.reorder` takes them.
     """
     layers = history.layers
     n_chains = history.windows[0].shape[0]
@@ -398,14 +476,16 @@ def _resample(history, sequences, frames, observed, n_particles, rng):
     ancestors = (cumulative[:, None, :, :] < positions[:, :, None, :]).sum(axis=2)
     np.minimum(ancestors, n_particles - 1, out=ancestors)
     chains = ancestors + (np.arange(n_groups) * n_particles)[:, None, None]
-    history.reorder(chains.reshape(n_chains, len(sequences)), sequences)
+    chains = chains.reshape(n_chains, len(sequences))
+    history.reorder(chains, sequences)
+    return chains
 
 
 def _split(layers, biases):
     """:meth:`History.biases` as two lists of 2-D arrays: visible, hidden."""
     visible, hidden = [], []
     for params, both in zip(layers, biases, strict=True):
-        both = both.reshape(-1, both.shape[-1])
+        both = params.ops.reshape(both, (-1, both.shape[-1]))
         visible.append(both[:, : params.n_features])
         hidden.append(both[:, params.n_features :])
     return visible, hidden

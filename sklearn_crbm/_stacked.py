@@ -6,10 +6,12 @@ import numpy as np
 from sklearn.base import _fit_context
 from sklearn.utils import check_random_state
 from sklearn.utils._param_validation import Interval
+from sklearn.utils._array_api import get_namespace
 from sklearn.utils.validation import validate_data
 
 from ._base import BaseCRBM
 from ._crbm import ConditionalRBM
+from .utils._array_api import array_ops
 from .utils._random import rng_from
 from .utils._sequences import check_sequence_ids
 from .utils._threads import batch_rows, limit_blas_threads
@@ -222,10 +224,13 @@ class StackedCRBM(BaseCRBM):
         )
 
     def _check_fit_input(self, X, sequence_ids, reset):
+        xp = get_namespace(X)[0]
+        if not reset:
+            self._check_namespace(X, "partial_fit")
         X = validate_data(
             self,
             X,
-            dtype=[np.float64, np.float32]
+            dtype=[xp.float64, xp.float32]
             if reset
             else self._layer_parameters()[0].dtype,
             reset=reset,
@@ -248,7 +253,7 @@ class StackedCRBM(BaseCRBM):
         """Hidden probabilities of ``layer`` on its valid frames, with their ids."""
         valid = check_sequence_ids(ids, X.shape[0]).valid_frames(layer._n_lags)
         hidden = layer.transform(X, sequence_ids=ids)
-        return hidden[valid], ids[valid]
+        return array_ops(hidden).take(hidden, valid, axis=0), ids[valid]
 
     # ------------------------------------------------------------------ fit
 
@@ -347,6 +352,11 @@ class StackedCRBM(BaseCRBM):
         # the top layer's chains draw from a generator of their own, seeded
         # from ``rng`` after the seeds are picked (as the layers are seeded)
         return rng_from(int(rng.integers(np.iinfo(np.int32).max)))
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.array_api_support = True
+        return tags
 
     def __sklearn_is_fitted__(self):
         # a fit that failed part-way leaves no layers: still "not fitted"

@@ -12,8 +12,10 @@ import itertools
 
 import numpy as np
 import pytest
+import sklearn
 from numpy.testing import assert_allclose, assert_array_equal
 from scipy.stats import norm
+from sklearn.externals import array_api_compat
 from sklearn.linear_model import Ridge
 
 from sklearn_crbm import ConditionalRBM
@@ -159,3 +161,18 @@ def test_binary_visibles_cannot_start_autoregressive():
     model = ConditionalRBM(3, visible_type="binary", init="autoregressive")
     with pytest.raises(ValueError, match="init='autoregressive'.*Gaussian"):
         model.fit(X)
+
+
+@pytest.mark.parametrize("namespace", ["array_api_strict", "torch"])
+def test_start_on_another_namespace_is_the_numpy_start(monkeypatch, data, namespace):
+    xp = pytest.importorskip(namespace)
+    X, ids = data
+    expected = started(monkeypatch, X, ids, visible_variance="learned")
+    with sklearn.config_context(array_api_dispatch=True):
+        model = started(monkeypatch, xp.asarray(X), ids, visible_variance="learned")
+        for name in ("autoregressive_", "intercept_visible_", "visible_variance_"):
+            got = getattr(model, name)
+            assert array_api_compat.array_namespace(got) is (
+                array_api_compat.array_namespace(xp.asarray(X))
+            )
+            assert_allclose(np.asarray(got), getattr(expected, name), rtol=1e-12)

@@ -108,7 +108,12 @@ def _imputer_results():
         train = X[IDS < 3].astype(dtype)
         for particles in (1, 3):
             imputer = CRBMImputer(
-                model, n_gibbs=4, n_draws=2, n_particles=particles, random_state=0
+                model,
+                n_gibbs=4,
+                n_draws=2,
+                n_particles=particles,
+                offset_shrinkage=None,
+                random_state=0,
             ).fit(train, sequence_ids=IDS[IDS < 3])
             key = f"particles{particles}.{dtype}"
             out[f"imputer.transform.{key}"] = imputer.transform(X_MISSING)
@@ -144,6 +149,7 @@ def _stacked_results():
             StackedCRBM((8, 4), order=1, n_iter=5, random_state=0),
             n_gibbs=4,
             n_particles=2,
+            offset_shrinkage=None,
             random_state=0,
         ).fit(X[IDS < 3].astype(dtype), sequence_ids=IDS[IDS < 3])
         out[f"stacked_imputer.transform.{dtype}"] = imputer.transform(X_MISSING)

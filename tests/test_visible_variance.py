@@ -24,11 +24,11 @@ from sklearn_crbm._crbm_math import (
     HiddenSampler,
     cd_gradients,
     dynamic_biases,
-    free_energy,
     hidden_probabilities,
     sample_visible_states,
     visible_means,
 )
+from sklearn_crbm._likelihood import FrameRBMs
 from sklearn_crbm.datasets import make_oscillations
 
 N_FEATURES, N_COMPONENTS, ORDER = 2, 3, 1
@@ -128,6 +128,12 @@ def test_samplers_follow_the_conditionals():
     draws = sample_visible_states(params, means, np.random.default_rng(4))
     noise = np.random.default_rng(4).standard_normal((n, N_FEATURES))
     assert_allclose(draws, means + np.sqrt(params.visible_variance) * noise)
+
+
+def free_energy(params, visible, visible_bias, hidden_bias):
+    """F(v | history) as the package computes it for its likelihood."""
+    rbms = FrameRBMs(params, visible_bias, hidden_bias, params.visible_std)
+    return -rbms.negative_free_energy(visible)
 
 
 def test_free_energy_by_enumeration():

@@ -14,13 +14,14 @@
 
 from ._acclaim import read_amc, write_amc
 from ._base import get_data_home, load_cmu35, load_mit_walk
+from ._bone import Bone
 from ._bvh import read_bvh, write_bvh
 from ._channels import bone_columns
 from ._fetch import fetch_cmu35, fetch_mit_walk
 from ._folders import read_amc_folder, read_bvh_folder
 from ._frame_rate import resample_frames
 from ._generators import make_oscillations, make_walker
-from ._skeleton import Bone, Skeleton
+from ._skeleton import Skeleton
 
 __all__ = [
     "Bone",

@@ -7,7 +7,7 @@ import numpy as np
 from sklearn.utils import Bunch
 
 from ._frame_rate import kept_frames
-from ._mit import load_mit_mat, read_mit_skeleton
+from ._mit import load_mit_mat
 from ._parsing import load_mat_variables
 from ._skeleton import Skeleton
 
@@ -236,7 +236,7 @@ def load_mit_walk(data_home=None):
     """
     path = _data_file(data_home, MIT_FOLDER, "data.mat", "fetch_mit_walk")
     skel, motions = load_mit_mat(path)
-    skeleton = read_mit_skeleton(skel, motions[0][0])
+    skeleton = Skeleton.from_mit(skel, motions[0][0])
     sequences = [
         motion[kept_frames(len(motion), MIT_RECORDING_RATE, FRAME_RATE)]
         for motion in motions

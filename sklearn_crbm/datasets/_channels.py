@@ -13,9 +13,9 @@ __all__ = [
     "KNOWN_CHANNELS",
     "OFFSET_CHANNELS",
     "TRANSLATION_CHANNELS",
-    "as_frames",
     "bone_columns",
     "column_indices",
+    "frame_columns",
 ]
 
 EULER_CHANNELS = ("rx", "ry", "rz")
@@ -84,22 +84,26 @@ def bone_columns(feature_names, bones, *, strict=True):
     return np.array(sorted(set(columns)), dtype=np.intp)
 
 
-def as_frames(data):
-    """``data`` as a float64 array, or a clear error for sparse or non-numeric data.
-
-    The shape is checked by the caller.
-    """
+def frame_columns(data, feature_names, required):
+    """``(X, columns)``: ``data`` as a 2-D float64 array and the
+    :func:`column_indices` of its ``feature_names``; a clear error for sparse,
+    non-numeric or not 2-D data."""
     if hasattr(data, "toarray") or hasattr(data, "tocsr"):
         raise TypeError(
             "data must be a dense array of raw channels, got a sparse matrix; "
             "convert it with .toarray()."
         )
     try:
-        return np.asarray(data, dtype=np.float64)
+        X = np.asarray(data, dtype=np.float64)
     except (TypeError, ValueError) as exc:
         raise ValueError(
             f"data must be a numeric array of shape (n_frames, n_features): {exc}"
         ) from None
+    if X.ndim != 2:
+        raise ValueError(
+            f"data must be 2-D (n_frames, n_features), got shape {X.shape}."
+        )
+    return X, column_indices(feature_names, required, n_columns=X.shape[1])
 
 
 def column_indices(feature_names, required, *, n_columns=None):

@@ -5,7 +5,8 @@ import numbers
 import numpy as np
 from sklearn.utils import Bunch, check_random_state
 
-from ._skeleton import Bone, Skeleton
+from ._bone import Bone
+from ._skeleton import Skeleton
 
 __all__ = ["make_oscillations", "make_walker", "walker_skeleton"]
 

@@ -33,11 +33,11 @@ import os
 
 import numpy as np
 
+from ._bone import Bone
 from ._channels import EXPMAP_CHANNELS, OFFSET_CHANNELS, TRANSLATION_CHANNELS
 from ._parsing import load_mat_variables
-from ._skeleton import Bone, Skeleton
 
-__all__ = ["MIT_BONE_NAMES", "read_mit_skeleton"]
+__all__ = ["MIT_BONE_NAMES", "parse_mit_skeleton"]
 
 MIT_BONE_NAMES = (
     "root", "lhip", "lknee", "lankle", "ltoe", "rhip", "rknee", "rankle", "rtoe",
@@ -69,8 +69,9 @@ def load_mit_mat(path):
     return mat["skel"], [np.asarray(m, dtype=np.float64) for m in mat["Motion"].flat]
 
 
-def read_mit_skeleton(skel, offsets=None):
-    """A :class:`Skeleton` from Taylor's MIT ``skel``; see :meth:`Skeleton.from_mit`."""
+def parse_mit_skeleton(skel, offsets=None):
+    """The keyword arguments of :class:`Skeleton` from Taylor's MIT ``skel``;
+    see :meth:`Skeleton.from_mit`."""
     if isinstance(skel, (str, os.PathLike)):
         skel, motions = load_mit_mat(skel)
         if offsets is None:
@@ -121,4 +122,10 @@ def read_mit_skeleton(skel, offsets=None):
                 + (TRANSLATION_CHANNELS if is_root else OFFSET_CHANNELS),
             )
         )
-    return Skeleton(bones, name="mit", up_axis="z", angle_unit="rad", convention="bvh")
+    return {
+        "bones": bones,
+        "name": "mit",
+        "up_axis": "z",
+        "angle_unit": "rad",
+        "convention": "bvh",
+    }

@@ -1,6 +1,7 @@
 """What both imputers share: input checks and the missing-value mask."""
 
 import numpy as np
+from sklearn.utils._array_api import _is_numpy_namespace, get_namespace
 from sklearn.utils._mask import _get_mask
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils.validation import FLOAT_DTYPES, validate_data
@@ -20,6 +21,15 @@ def check_imputer_input(imputer, X, *, reset):
     mask : ndarray of bool of shape (n_frames, n_features)
         True where ``X`` holds ``missing_values``.
     """
+    xp = get_namespace(X)[0]
+    if not _is_numpy_namespace(xp):
+        raise TypeError(
+            f"{type(imputer).__name__} fills numpy arrays only; got {xp.__name__} "
+            "input under sklearn.set_config(array_api_dispatch=True). Pass X as a "
+            "numpy array (e.g. X.cpu().numpy() for a torch tensor); a model trained "
+            "on a GPU moves to numpy with sklearn.utils._array_api."
+            "move_estimator_to(model, numpy, 'cpu')."
+        )
     ensure_all_finite = "allow-nan" if is_scalar_nan(imputer.missing_values) else True
     X = validate_data(
         imputer,

@@ -25,6 +25,7 @@ from ._layout import (
     check_encoded,
     expmap_layout,
     find_euler_blocks,
+    input_names,
     moving_root,
     skeleton_feature_names,
 )
@@ -160,21 +161,6 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         self.continuous = continuous
         self.reference = reference
 
-    def _input_names(self, n_features):
-        if hasattr(self, "feature_names_in_"):
-            return self.feature_names_in_
-        if self.skeleton is not None:
-            names = skeleton_feature_names(self.skeleton)
-            if len(names) != n_features:
-                raise ValueError(
-                    f"X has {n_features} columns but the skeleton has "
-                    f"{len(names)} channels; a plain array must hold exactly "
-                    "skeleton.feature_names, in order (or pass a DataFrame "
-                    "with those column names)."
-                )
-            return names
-        return None
-
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None, *, sequence_ids=None):
         """Find the Euler-angle blocks of each bone.
@@ -195,7 +181,12 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         """
         X = validate_data(self, X, dtype=np.float64, ensure_all_finite="allow-nan")
         check_sequence_ids(sequence_ids, X.shape[0])
-        names = self._input_names(X.shape[1])
+        names = input_names(
+            self,
+            X.shape[1],
+            skeleton_feature_names,
+            "the skeleton has {} channels (skeleton.feature_names)",
+        )
         if names is None:
             self._blocks = []
             names = np.asarray([f"x{i}" for i in range(X.shape[1])], dtype=object)

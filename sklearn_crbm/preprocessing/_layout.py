@@ -218,6 +218,28 @@ def expmap_layout(feature_names, blocks):
     )
 
 
+def input_names(estimator, n_features, skeleton_names, described):
+    """Names of the columns an encoder is fitted on, or None when unknown.
+
+    ``feature_names_in_`` when ``X`` had names; else, with a skeleton,
+    ``skeleton_names(skeleton)``, which a plain array must match column for
+    column (``described``, formatted with their number, says what they are
+    in the error).
+    """
+    if hasattr(estimator, "feature_names_in_"):
+        return np.asarray(estimator.feature_names_in_, dtype=object)
+    if estimator.skeleton is None:
+        return None
+    names = skeleton_names(estimator.skeleton)
+    if len(names) != n_features:
+        raise ValueError(
+            f"X has {n_features} columns but {described.format(len(names))}; a "
+            "plain array must hold exactly those columns, in order (or pass a "
+            "DataFrame with those column names)."
+        )
+    return names
+
+
 def expmap_feature_names(skeleton):
     """Column names of a skeleton's raw channels once encoded as exp maps."""
     names = skeleton_feature_names(skeleton)

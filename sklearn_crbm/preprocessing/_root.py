@@ -23,6 +23,7 @@ from ._layout import (
     check_encoded,
     check_skeleton,
     expmap_feature_names,
+    input_names,
     moving_root,
 )
 
@@ -39,6 +40,43 @@ _STEEP_FORWARD_DEG = 30.0
 def _wrap(angle):
     """Angles wrapped into ``[-pi, pi)``."""
     return (angle + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def _integrate(dheading, dforward, dsideways, sequences):
+    """Heading (wrapped) and ground position of every frame from the deltas,
+    each sequence starting at heading 0 and ground position (0, 0)."""
+    n = len(dheading)
+    heading = np.zeros(n)
+    ground = np.zeros((n, 2))
+    for start, stop in zip(sequences.starts, sequences.stops, strict=True):
+        moves = slice(start, stop - 1)
+        h = np.concatenate([[0.0], np.cumsum(dheading[moves])])
+        heading[start:stop] = h
+        cos, sin = np.cos(h[:-1]), np.sin(h[:-1])
+        steps = np.column_stack(
+            [
+                cos * dforward[moves] + sin * dsideways[moves],
+                sin * dforward[moves] - cos * dsideways[moves],
+            ]
+        )
+        ground[start + 1 : stop] = np.cumsum(steps, axis=0)
+    return _wrap(heading), ground
+
+
+def _outputs(channels, up):
+    """The encoded channels, in the order of ``_ROOT_OUT``, that ``channels`` give."""
+    present = set(channels)
+    rotation = len(present & {"ex", "ey", "ez"})
+    ground = sum(f"t{a}" in present for a in "xyz" if a != up) == 2
+    given = {
+        "pitch": rotation == 3,
+        "roll": rotation == 3,
+        "dheading": rotation > 0,
+        "dforward": ground,
+        "dsideways": ground,
+        "height": f"t{up}" in present,
+    }
+    return [c for c in _ROOT_OUT if given[c]]
 
 
 class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
@@ -75,8 +113,12 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
     ``{root}_height``
         The root's height above the ground plane (absolute).
 
-    The six columns stand where the first of the six root channels stood;
-    every other column passes through.  One row comes out per row in: the
+    With ``channels`` a root that has only some of the six channels is
+    encoded as far as it goes (see the parameter): each output needs the
+    channels it is computed from, and as many columns come out as go in.
+
+    The root's output columns stand where the first of its input channels
+    stood; every other column passes through.  One row comes out per row in: the
     *last* frame of each sequence has no next frame and repeats the deltas
     of the frame before it (as the original code does; 0 for a sequence of
     one frame).  The deltas never cross a sequence boundary.
@@ -90,7 +132,8 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         _ez``), in the skeleton's order.  Input with feature names (a
         DataFrame) is always located by name.  Without names and without a
         skeleton, the first six columns are taken as ``tx, ty, tz, ex, ey,
-        ez`` (the ASF/BVH layout after :class:`ExpMapEncoder`).
+        ez`` (the ASF/BVH layout after :class:`ExpMapEncoder`), or the
+        first ``len(channels)`` columns, in the order of ``channels``.
     up_axis : {"x", "y", "z"} or None, default=None
         The vertical axis of the world frame.  None takes the skeleton's, or
         ``"y"`` (CMU, BVH) without a skeleton; Taylor's MIT data is ``"z"``.
@@ -113,13 +156,36 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         paper's encoding), which cannot tell an orientation from its mirror
         image once the body's up axis points below the horizon: then
         :meth:`transform` warns and names the frames.
+    channels : sequence of str or None, default=None
+        The root channels the data holds, from ``"tx", "ty", "tz", "ex",
+        "ey", "ez"``; None means all six.  For a root that is a point or a
+        ground vehicle rather than a body (a marker, a pedestrian track, a
+        robot's ``(x, z, yaw)``), or a rig whose root lacks some channels.
+        Writing ``"t<up>"`` and ``"e<up>"`` for the channels along the up
+        axis (``"ty"``, ``"ey"`` when y is up) and "ground" for the two
+        other translations, the outputs are:
+
+        - ``{root}_pitch``, ``{root}_roll``: with all three of ``ex, ey, ez``;
+        - ``{root}_dheading``: with all three, or with ``"e<up>"`` alone (a
+          rotation about the vertical only, whose exponential map is the
+          heading angle); without any rotation the heading is 0, so the
+          steps below are along the world's forward and left axes;
+        - ``{root}_dforward``, ``{root}_dsideways``: with both ground
+          translations (one alone is refused);
+        - ``{root}_height``: with ``"t<up>"``.
+
+        E.g. ``("tx", "tz")`` with y up makes a ground track invariant to
+        where it starts, and ``("tx", "tz", "ey")`` also to which way it
+        faces.  ``inverse_transform`` gives a yaw-only root its angle in
+        ``[-pi, pi)``.
 
     Attributes
     ----------
     root_ : str
         Name of the root bone used.
-    root_columns_ : ndarray of shape (6,)
-        Input columns of ``tx, ty, tz, ex, ey, ez``.
+    root_columns_ : ndarray of shape (n_channels,)
+        Input columns of the root channels, in the order of ``channels``
+        (``tx, ty, tz, ex, ey, ez`` by default).
     up_axis_ : str
         The vertical axis used.
     n_features_in_ : int
@@ -172,6 +238,21 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
            [ 1.5708,  1.5708,  0.    ,  2.    ,  0.    , 17.    ]])
     >>> np.allclose(encoder.inverse_transform(encoder.transform(X)), X)
     True
+
+    A ground track alone, in the world's axes (forward z, left x when y is
+    up), then with the direction it faces (``ey``, radians):
+
+    >>> track = RootRelativeEncoder(channels=("tx", "tz")).fit(X[:, [0, 2]])
+    >>> track.get_feature_names_out()
+    array(['root_dforward', 'root_dsideways'], dtype=object)
+    >>> tx = [0.0, 2.0, 4.0, 6.0]
+    >>> turned = np.column_stack([tx, np.zeros(4), np.full(4, np.pi / 2)])
+    >>> vehicle = RootRelativeEncoder(channels=("tx", "tz", "ey")).fit(turned)
+    >>> vehicle.get_feature_names_out()
+    array(['root_dheading', 'root_dforward', 'root_dsideways'], dtype=object)
+    >>> # facing +x and moving along it: 2 forward, none sideways, no turn
+    >>> np.allclose(vehicle.transform(turned), [0.0, 2.0, 0.0])
+    True
     """
 
     __metadata_request__fit = {"sequence_ids": True}
@@ -183,13 +264,17 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         "up_axis": [StrOptions({"x", "y", "z"}), None],
         "root": [str, None],
         "roll": [StrOptions({"euler", "taylor"})],
+        "channels": [list, tuple, None],
     }
 
-    def __init__(self, skeleton=None, *, up_axis=None, root=None, roll="euler"):
+    def __init__(
+        self, skeleton=None, *, up_axis=None, root=None, roll="euler", channels=None
+    ):
         self.skeleton = skeleton
         self.up_axis = up_axis
         self.root = root
         self.roll = roll
+        self.channels = channels
 
     def _root_name(self, names, X):
         if self.root is not None:
@@ -199,21 +284,6 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         if self.skeleton is not None:
             check_skeleton(self.skeleton)
         return moving_root(names, X, self.skeleton) or "root"
-
-    def _layout_names(self, n_features):
-        if hasattr(self, "feature_names_in_"):
-            return np.asarray(self.feature_names_in_, dtype=object)
-        if self.skeleton is not None:
-            names = expmap_feature_names(self.skeleton)
-            if len(names) != n_features:
-                raise ValueError(
-                    f"X has {n_features} columns but the skeleton's channels, "
-                    f"after ExpMapEncoder, are {len(names)}; a plain array must "
-                    "hold exactly those columns, in order (or pass a DataFrame "
-                    "with column names)."
-                )
-            return names
-        return None
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None, *, sequence_ids=None):
@@ -242,56 +312,99 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         if up not in _AXES:
             raise ValueError(f"up_axis must be 'x', 'y' or 'z', got {up!r}.")
         self.up_axis_ = up
-        names = self._layout_names(X.shape[1])
+        channels = self._check_channels(up)
+        names = input_names(
+            self,
+            X.shape[1],
+            expmap_feature_names,
+            "the skeleton's channels, after ExpMapEncoder, are {}",
+        )
         root = self._root_name(names, X)
-        wanted = [f"{root}_{c}" for c in _ROOT_IN]
+        wanted = [f"{root}_{c}" for c in channels]
         if names is None:
-            if X.shape[1] < 6:
+            if X.shape[1] < len(channels):
                 raise ValueError(
                     f"X has {X.shape[1]} feature(s); RootRelativeEncoder needs the "
-                    "six root channels (tx, ty, tz, ex, ey, ez), which without "
-                    "feature names or a skeleton are the first six columns."
+                    f"{len(channels)} root channels ({', '.join(channels)}), which "
+                    "without feature names or a skeleton are the first "
+                    f"{len(channels)} columns; for a root with fewer channels "
+                    "pass channels=."
                 )
-            columns = np.arange(6)
+            columns = np.arange(len(channels))
             names = np.asarray([f"x{i}" for i in range(X.shape[1])], dtype=object)
         else:
-            position = {str(n): j for j, n in enumerate(names)}
-            missing = [w for w in wanted if w not in position]
-            if missing:
-                hint = ""
-                if any(f"{root}_r{a}" in position for a in "xyz"):
-                    hint = (
-                        " The root still has Euler channels: apply ExpMapEncoder first."
-                    )
-                elif all(w[len(root) :] not in ("_ex", "_ey", "_ez") for w in missing):
-                    hint = (
-                        f" The root bone {root!r} needs position channels (tx, ty, "
-                        "tz) as well as rotations."
-                    )
-                raise ValueError(
-                    f"X lacks the root channels {missing}; RootRelativeEncoder "
-                    f"needs {wanted} (root={root!r}: pass root= to name another "
-                    f"bone).{hint}"
-                )
-            columns = np.array([position[w] for w in wanted])
+            columns = self._named_columns(names, root, wanted)
         self.root_columns_ = columns
         self.root_ = root
-        self._check_up_axis(X)
+        self._column = dict(zip(channels, columns.tolist(), strict=True))
+        self._outputs = _outputs(channels, up)
+        if self._full_orientation():
+            self._check_up_axis(X)
         self._names_in = np.asarray(names, dtype=object)
         others = np.setdiff1d(np.arange(X.shape[1]), columns)
         first = columns.min()
         before = others[others < first]
         after = others[others > first]
+        k = len(columns)
         self._pass_in = np.concatenate([before, after])
         self._pass_out = np.concatenate(
-            [np.arange(len(before)), len(before) + 6 + np.arange(len(after))]
+            [np.arange(len(before)), len(before) + k + np.arange(len(after))]
         ).astype(np.intp)
-        self._root_out = len(before) + np.arange(6)
+        self._root_out = len(before) + np.arange(k)
         return self
+
+    def _check_channels(self, up):
+        """``channels`` as a tuple, or a ValueError saying which sets work."""
+        if self.channels is None:
+            return _ROOT_IN
+        channels = tuple(str(c) for c in self.channels)
+        unknown = sorted(set(channels) - set(_ROOT_IN))
+        if unknown or not channels or len(set(channels)) < len(channels):
+            raise ValueError(
+                f"channels must name distinct root channels from {list(_ROOT_IN)}, "
+                f"got {list(channels)}."
+            )
+        ground = [f"t{a}" for a in "xyz" if a != up]
+        rotation = {"ex", "ey", "ez"} & set(channels)
+        if sum(g in channels for g in ground) == 1:
+            raise ValueError(
+                f"channels {list(channels)} hold one ground-plane translation; the "
+                f"ground steps need both {ground} (up axis {up!r}), or neither."
+            )
+        if rotation not in (set(), {"ex", "ey", "ez"}, {f"e{up}"}):
+            raise ValueError(
+                f"channels {list(channels)} hold the rotation channels "
+                f"{sorted(rotation)}; an orientation needs all of ex, ey, ez, or "
+                f"e{up} alone (a rotation about the up axis {up!r}: the heading)."
+            )
+        return channels
+
+    def _named_columns(self, names, root, wanted):
+        """Columns of the ``wanted`` names, or a ValueError with a hint."""
+        position = {str(n): j for j, n in enumerate(names)}
+        missing = [w for w in wanted if w not in position]
+        if not missing:
+            return np.array([position[w] for w in wanted])
+        present = [c for c in _ROOT_IN if f"{root}_{c}" in position]
+        hint = ""
+        if any(f"{root}_r{a}" in position for a in "xyz"):
+            hint = " The root still has Euler channels: apply ExpMapEncoder first."
+        elif present:
+            hint = (
+                f" The data has the root channels {present}: pass channels= to "
+                "encode those."
+            )
+        raise ValueError(
+            f"X lacks the root channels {missing}; RootRelativeEncoder needs "
+            f"{wanted} (root={root!r}: pass root= to name another bone).{hint}"
+        )
+
+    def _full_orientation(self):
+        return "pitch" in self._outputs
 
     def _check_up_axis(self, X):
         """Warn when the forward axis is steep in most frames: a wrong up axis."""
-        R = self._local_rotations(X[:, self.root_columns_[3:]])
+        R = self._local_rotations(X[:, self._expmap_columns()])
         R = R[np.all(np.isfinite(R), axis=(1, 2))]
         if len(R) == 0:
             return
@@ -301,7 +414,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         # the world axis that the root's up axis (taken to be the same letter
         # as the world's) points along in most frames
         u = _AXES[self.up_axis_]
-        body_up = expmap_to_matrix(X[:, self.root_columns_[3:]])[:, :, u]
+        body_up = expmap_to_matrix(X[:, self._expmap_columns()])[:, :, u]
         best = "xyz"[int(np.argmax(np.nanmean(np.abs(body_up), axis=0)))]
         forward = "xyz"[self._permutation()[0]]
         warnings.warn(
@@ -371,19 +484,9 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             self, X, reset=False, dtype=np.float64, ensure_all_finite="allow-nan"
         )
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
-        perm = self._permutation()
-        position = X[:, self.root_columns_[:3]][:, perm]
-        R = self._local_rotations(X[:, self.root_columns_[3:]])
-        if self.roll == "taylor":
-            pitch, roll, heading = self._taylor_angles(R)
-        else:
-            # R = R_z(heading) R_y(pi/2 - pitch) R_x(roll - pi/2), exactly
-            angles = matrix_to_euler(R, "xyz")
-            roll = angles[:, 0] + np.pi / 2
-            pitch = np.pi / 2 - angles[:, 1]
-            heading = angles[:, 2]
-
         n = X.shape[0]
+        position = self._local_positions(X)
+        encoded, heading = self._orientation(X)
         dheading = np.zeros(n)
         step = np.zeros((n, 2))
         if n > 1:
@@ -397,12 +500,50 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         long = sequences.lengths > 1
         deltas[last[long]] = deltas[last[long] - 1]
         deltas[last[~long]] = 0.0
+        encoded.update(
+            zip(("dheading", "dforward", "dsideways"), deltas.T, strict=True)
+        )
+        encoded["height"] = position[:, 2]
 
         out = np.empty_like(X)
         out[:, self._pass_out] = X[:, self._pass_in]
-        root = np.column_stack([pitch, roll, deltas, position[:, 2]])
-        out[:, self._root_out] = root
+        out[:, self._root_out] = np.column_stack([encoded[c] for c in self._outputs])
         return out
+
+    def _local_positions(self, X):
+        """Root positions in (forward, left, up) coordinates; 0 where absent."""
+        position = np.zeros((X.shape[0], 3))
+        for axis, column in self._translation_columns():
+            position[:, axis] = X[:, column]
+        return position[:, self._permutation()]
+
+    def _translation_columns(self):
+        """``(world axis, input column)`` of every translation channel present."""
+        return [
+            (i, self._column[f"t{a}"])
+            for i, a in enumerate("xyz")
+            if f"t{a}" in self._column
+        ]
+
+    def _orientation(self, X):
+        """``({"pitch": ..., "roll": ...}, heading)``: as far as the channels give."""
+        if self._full_orientation():
+            R = self._local_rotations(X[:, self._expmap_columns()])
+            if self.roll == "taylor":
+                pitch, roll, heading = self._taylor_angles(R)
+            else:
+                # R = R_z(heading) R_y(pi/2 - pitch) R_x(roll - pi/2), exactly
+                angles = matrix_to_euler(R, "xyz")
+                roll = angles[:, 0] + np.pi / 2
+                pitch = np.pi / 2 - angles[:, 1]
+                heading = angles[:, 2]
+            return {"pitch": pitch, "roll": roll}, heading
+        if "dheading" in self._outputs:  # a rotation about the vertical only
+            return {}, X[:, self._column[f"e{self.up_axis_}"]]
+        return {}, np.zeros(X.shape[0])
+
+    def _expmap_columns(self):
+        return [self._column[c] for c in ("ex", "ey", "ez")]
 
     def _taylor_angles(self, R):
         """Taylor's pitch, roll and heading; warns about frames it cannot invert."""
@@ -472,41 +613,34 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         check_is_fitted(self)
         X = check_encoded(X, self.n_features_in_, type(self).__name__)
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
-        root = X[:, self._root_out]
-        pitch, roll, dheading, dforward, dsideways, height = root.T
         n = X.shape[0]
-        heading = np.zeros(n)
-        ground = np.zeros((n, 2))
-        for start, stop in zip(sequences.starts, sequences.stops, strict=True):
-            moves = slice(start, stop - 1)
-            h = np.concatenate([[0.0], np.cumsum(dheading[moves])])
-            heading[start:stop] = h
-            cos, sin = np.cos(h[:-1]), np.sin(h[:-1])
-            steps = np.column_stack(
-                [
-                    cos * dforward[moves] + sin * dsideways[moves],
-                    sin * dforward[moves] - cos * dsideways[moves],
-                ]
-            )
-            ground[start + 1 : stop] = np.cumsum(steps, axis=0)
-        heading = _wrap(heading)
-
-        if self.roll == "taylor":
-            R_local = self._taylor_rotations(pitch, roll, heading)
-        else:
-            angles = np.column_stack([roll - np.pi / 2, np.pi / 2 - pitch, heading])
-            R_local = euler_to_matrix(angles, "xyz")
-
-        perm = self._permutation()
-        inv = np.argsort(perm)
-        R = R_local[:, inv][:, :, inv]
+        encoded = dict(zip(self._outputs, X[:, self._root_out].T, strict=True))
+        dheading, dforward, dsideways, height = (
+            encoded.get(c, np.zeros(n))
+            for c in ("dheading", "dforward", "dsideways", "height")
+        )
+        heading, ground = _integrate(dheading, dforward, dsideways, sequences)
+        inv = np.argsort(self._permutation())
         position = np.column_stack([ground, height])[:, inv]
-
         out = np.empty_like(X)
         out[:, self._pass_in] = X[:, self._pass_out]
-        out[:, self.root_columns_[:3]] = position
-        out[:, self.root_columns_[3:]] = matrix_to_expmap(R)
+        for axis, column in self._translation_columns():
+            out[:, column] = position[:, axis]
+        if self._full_orientation():
+            R_local = self._rotations(encoded["pitch"], encoded["roll"], heading)
+            out[:, self._expmap_columns()] = matrix_to_expmap(
+                R_local[:, inv][:, :, inv]
+            )
+        elif "dheading" in self._outputs:
+            out[:, self._column[f"e{self.up_axis_}"]] = heading
         return out
+
+    def _rotations(self, pitch, roll, heading):
+        """Root rotations in (forward, left, up) coordinates from the angles."""
+        if self.roll == "taylor":
+            return self._taylor_rotations(pitch, roll, heading)
+        angles = np.column_stack([roll - np.pi / 2, np.pi / 2 - pitch, heading])
+        return euler_to_matrix(angles, "xyz")
 
     def get_feature_names_out(self, input_features=None):
         """Output feature names.
@@ -530,7 +664,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             names_in = _check_feature_names_in(self, input_features)
         out = np.empty(self.n_features_in_, dtype=object)
         out[self._pass_out] = np.asarray(names_in, dtype=object)[self._pass_in]
-        out[self._root_out] = [f"{self.root_}_{c}" for c in _ROOT_OUT]
+        out[self._root_out] = [f"{self.root_}_{c}" for c in self._outputs]
         return out
 
     def __sklearn_is_fitted__(self):

@@ -12,6 +12,8 @@ from numbers import Integral
 
 import numpy as np
 
+from ._array_api import array_ops
+
 __all__ = [
     "Sequences",
     "balanced_batches",
@@ -229,6 +231,11 @@ def frame_history(X, frames, n_lags, frame_starts=None, out=None):
     """
     indices = history_indices(frames, n_lags, frame_starts)
     n_features = X.shape[1]
+    if not isinstance(X, np.ndarray):  # another array API namespace
+        ops = array_ops(X)
+        gathered = ops.take(X, indices.ravel(), axis=0)
+        flat = ops.reshape(gathered, (len(indices), n_lags * n_features))
+        return ops._into(out, flat)
     if out is None:
         return X[indices.ravel()].reshape(len(indices), n_lags * n_features)
     # mode="clip": with mode="raise" numpy buffers ``out`` (several times slower)

@@ -1,5 +1,6 @@
 """RootRelativeEncoder: global root <-> body-centred root."""
 
+import dataclasses
 import pickle
 import warnings
 
@@ -183,8 +184,9 @@ def test_unnamed_array_uses_the_first_six_columns():
 
 
 def test_estimator_basics_on_root_data():
-    """What sklearn's common checks cannot test here (their data has fewer than
-    six columns): fit returns self, idempotence, pickling, input containers."""
+    """The basics sklearn's common checks test on partial roots (their data has
+    fewer than six columns), on a whole root located through a skeleton: fit
+    returns self, idempotence, pickling, input containers."""
     walker = make_walker(n_sequences=2, n_frames=15, random_state=2)
     X = ExpMapEncoder(walker.skeleton).fit_transform(walker.data)
     encoder = RootRelativeEncoder(walker.skeleton)
@@ -316,3 +318,168 @@ def test_the_root_is_the_skeletons_first_bone():
     )
     with pytest.raises(ValueError, match=r"root='pelvis'.*pass root="):
         RootRelativeEncoder(skeleton, root="pelvis").fit(X)
+
+
+# ------------------------------------------------------- roots with some channels
+ROOT_IN = ["tx", "ty", "tz", "ex", "ey", "ez"]
+# what a root holds, in words; _channels names the channels for an up axis
+ROLES = [
+    ("ground",),
+    ("ground", "height"),
+    ("ground", "yaw"),
+    ("ground", "height", "yaw"),
+    ("yaw",),
+    ("rotation",),
+    ("height", "rotation"),
+]
+
+
+def _channels(roles, up):
+    u = "xyz".index(up)
+    ground = ["xyz"[(u + 1) % 3], "xyz"[(u + 2) % 3]]
+    names = {
+        "ground": [f"t{a}" for a in ground],
+        "height": [f"t{up}"],
+        "yaw": [f"e{up}"],
+        "rotation": ["ex", "ey", "ez"],
+    }
+    return [c for role in roles for c in names[role]]
+
+
+def _wrap(angle):
+    return (angle + np.pi) % (2 * np.pi) - np.pi
+
+
+def _turning_walk(n, seed, up):
+    """Root channels (tx, ty, tz, ex, ey, ez) of a body that walks on the ground
+    and turns about the vertical only, from the origin at heading 0."""
+    rng = np.random.default_rng(seed)
+    X = np.zeros((n, 6))
+    u = "xyz".index(up)
+    ground = [(u + 1) % 3, (u + 2) % 3]
+    X[1:, ground] = np.cumsum(rng.normal(size=(n - 1, 2)), axis=0)
+    X[:, u] = 10.0 + rng.normal(size=n)
+    X[:, 3 + u] = _wrap(np.cumsum(np.r_[0.0, rng.normal(scale=0.5, size=n - 1)]))
+    return X
+
+
+@pytest.mark.parametrize("up", ["x", "y", "z"])
+@pytest.mark.parametrize("roles", ROLES, ids="+".join)
+def test_a_partial_root_is_the_whole_root_with_its_other_channels_at_zero(roles, up):
+    channels = _channels(roles, up)
+    X = _turning_walk(60, 0, up)
+    if "rotation" in roles:  # every orientation, not only turns
+        X[:, 3:] = _random_root(60, seed=0, up=up)[:, 3:]
+    kept = [ROOT_IN.index(c) for c in channels]
+    zeroed = np.zeros_like(X)
+    zeroed[:, kept] = X[:, kept]
+    whole = RootRelativeEncoder(up_axis=up)
+    expected = whole.fit_transform(zeroed)
+    # the channels in another order than the whole root's
+    partial = RootRelativeEncoder(up_axis=up, channels=channels[::-1])
+    E = partial.fit_transform(X[:, kept[::-1]])
+    names = list(partial.get_feature_names_out())
+    assert len(names) == len(channels)
+    whole_names = list(whole.get_feature_names_out())
+    assert names == [n for n in whole_names if n in names]
+    columns = [whole_names.index(n) for n in names]
+    np.testing.assert_allclose(E, expected[:, columns], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("up", ["x", "y", "z"])
+@pytest.mark.parametrize("roles", ROLES, ids="+".join)
+def test_a_partial_root_round_trips_from_the_start_pose(roles, up):
+    """Sequences that start at the origin facing heading 0 come back exactly;
+    the other columns pass through."""
+    root = np.vstack([_turning_walk(40, 1, up), _turning_walk(25, 2, up)])
+    ids = np.repeat([0, 1], [40, 25])
+    channels = _channels(roles, up)[::-1]
+    other = np.random.default_rng(3).normal(size=(len(root), 2))
+    X = np.column_stack([root[:, [ROOT_IN.index(c) for c in channels]], other])
+    encoder = RootRelativeEncoder(up_axis=up, channels=channels).fit(X)
+    k = len(channels)
+    assert encoder.root_columns_.tolist() == list(range(k))
+    E = encoder.transform(X, sequence_ids=ids)
+    assert np.array_equal(E[:, k:], other)
+    assert list(encoder.get_feature_names_out()[k:]) == [f"x{k}", f"x{k + 1}"]
+    back = encoder.inverse_transform(E, sequence_ids=ids)
+    np.testing.assert_allclose(back, X, rtol=0, atol=1e-12)
+
+
+def test_a_ground_track_with_heading_forgets_where_it_starts_and_faces():
+    X = _turning_walk(50, 4, "y")[:, [0, 2, 4]]  # tx, tz, ey
+    moved = X.copy()
+    turn, shift = 2.0, np.array([30.0, -7.0])
+    # a turn of the whole track about +y: (x, z) -> (x cos + z sin, z cos - x sin)
+    moved[:, 0] = X[:, 0] * np.cos(turn) + X[:, 1] * np.sin(turn) + shift[0]
+    moved[:, 1] = X[:, 1] * np.cos(turn) - X[:, 0] * np.sin(turn) + shift[1]
+    moved[:, 2] = _wrap(X[:, 2] + turn)
+    vehicle = RootRelativeEncoder(channels=["tx", "tz", "ey"]).fit(X)
+    assert list(vehicle.get_feature_names_out()) == ROOT_OUT[2:5]
+    np.testing.assert_allclose(
+        vehicle.transform(moved), vehicle.transform(X), rtol=0, atol=1e-12
+    )
+    # without the heading, the steps are in the world's axes: only the shift goes
+    track = RootRelativeEncoder(channels=["tx", "tz"]).fit(X[:, :2])
+    shifted = X[:, :2] + shift
+    np.testing.assert_allclose(
+        track.transform(shifted), track.transform(X[:, :2]), rtol=0, atol=1e-12
+    )
+    assert not np.allclose(track.transform(moved[:, :2]), track.transform(X[:, :2]))
+    # world forward is +z, the body's right -x when y is up
+    steps = np.diff(X[:, :2], axis=0)
+    assert np.allclose(track.transform(X[:, :2])[:-1], steps[:, [1, 0]] * [1, -1])
+
+
+def test_partial_root_channels_are_found_by_name_through_a_skeleton():
+    """A rig whose root cannot move vertically: tx, tz and a rotation."""
+    walker = make_walker(n_sequences=1, n_frames=30, random_state=5)
+    bones = list(walker.skeleton.bones)
+    flat_root = dataclasses.replace(bones[0], channels=("tx", "tz", "rx", "ry", "rz"))
+    skeleton = type(walker.skeleton)([flat_root, *bones[1:]])
+    X = ExpMapEncoder(skeleton).fit_transform(np.delete(walker.data, 1, axis=1))
+    with pytest.raises(
+        ValueError,
+        match=r"lacks the root channels \['root_ty'\].*has the root channels "
+        r"\['tx', 'tz', 'ex', 'ey', 'ez'\]: pass channels=",
+    ):
+        RootRelativeEncoder(skeleton).fit(X)
+    channels = ("ex", "ey", "ez", "tx", "tz")
+    named = RootRelativeEncoder(skeleton, channels=channels).fit(X)
+    assert named.root_columns_.tolist() == [2, 3, 4, 0, 1]
+    positional = RootRelativeEncoder(channels=channels).fit(X[:, [2, 3, 4, 0, 1]])
+    np.testing.assert_array_equal(
+        named.transform(X)[:, :5], positional.transform(X[:, [2, 3, 4, 0, 1]])[:, :5]
+    )
+    assert list(named.get_feature_names_out()[:5]) == ROOT_OUT[:5]
+    assert np.array_equal(named.transform(X)[:, 5:], X[:, 5:])
+
+
+@pytest.mark.parametrize(
+    "channels, up, message",
+    [
+        (["tx"], "y", r"one ground-plane translation; .* both \['tx', 'tz'\]"),
+        (["ty", "tz", "ez"], "z", r"one ground-plane translation"),
+        (["ex"], "y", r"all of ex, ey, ez, or ey alone"),
+        (["tx", "tz", "ex", "ey"], "y", r"rotation channels \['ex', 'ey'\]"),
+        (["tx", "tx"], "y", "distinct root channels"),
+        (["rx"], "y", "distinct root channels"),
+        ([], "y", "distinct root channels"),
+    ],
+)
+def test_impossible_channel_sets_raise(channels, up, message):
+    with pytest.raises(ValueError, match=message):
+        RootRelativeEncoder(up_axis=up, channels=channels).fit(np.zeros((4, 6)))
+
+
+def test_too_few_columns_for_the_channels_raise():
+    with pytest.raises(ValueError, match=r"X has 2 feature\(s\).* 3 root channels"):
+        RootRelativeEncoder(channels=("tx", "tz", "ey")).fit(np.zeros((4, 2)))
+
+
+def test_a_yaw_comes_back_wrapped():
+    X = np.linspace(0.0, 9.0, 10)[:, None]  # a steady turn, past pi
+    encoder = RootRelativeEncoder(channels=("ey",)).fit(X)
+    E = encoder.transform(X)
+    assert np.allclose(E, 1.0)
+    np.testing.assert_allclose(encoder.inverse_transform(E), _wrap(X), atol=1e-12)

@@ -1832,7 +1832,7 @@ SKELETON_CASES = [
         "RootRelativeEncoder-root still in Euler angles",
         lambda c: RootRelativeEncoder().fit(c.walker.data[:, :5]),
         ValueError,
-        "X has 5 feature.*needs the six root channels",
+        "X has 5 feature.*needs the 6 root channels.*pass channels=",
     ),
 ]
 

@@ -1,0 +1,134 @@
+"""CRBMImputer's offset correction (``offset_shrinkage``), against a loop written out."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+from sklearn.frozen import FrozenEstimator
+from sklearn.utils._param_validation import InvalidParameterError
+
+from sklearn_crbm import ConditionalRBM
+from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.impute import CRBMImputer
+
+
+@pytest.fixture(scope="module")
+def data():
+    X, ids = make_oscillations(n_sequences=5, n_frames=40, n_features=3, random_state=0)
+    return X, ids
+
+
+@pytest.fixture(scope="module")
+def model(data):
+    X, ids = data
+    return ConditionalRBM(4, order=2, n_iter=20, random_state=0).fit(
+        X, sequence_ids=ids
+    )
+
+
+def _sigmoid(a):
+    return 1 / (1 + np.exp(-a))
+
+
+def reference_fill(model, X_missing, shrinkage):
+    """The corrected on-line fill with ``n_gibbs=0`` and one chain, written out.
+
+    Frame ``t`` (past ``x[t-1], x[t-2]``, the fills where missing): dynamic
+    biases ``b = b0 + sum_q A_q x[t-q]`` and ``c = c0 + sum_q B_q x[t-q]``;
+    prediction ``v <- b + W^T sigmoid(c + W v)`` ten times from ``v = b``;
+    the residual ``x_t - v`` of each observed channel is summed (frames from
+    the order on).  A missing channel starts at its previous value, gets one
+    mean-field step ``b + W^T sigmoid(c + W start)``, plus ``sum / (n +
+    shrinkage)``.  The first frames must be complete.
+    """
+    W = model.components_
+    A = model.autoregressive_
+    B = model.past_to_hidden_
+    b0, c0 = model.intercept_visible_, model.intercept_hidden_
+    x = X_missing.copy()
+    missing = np.isnan(X_missing)
+    sums = np.zeros(x.shape[1])
+    counts = np.zeros(x.shape[1])
+    for t in range(2, len(x)):
+        b = b0 + sum(A[q] @ x[t - 1 - q] for q in range(2))
+        c = c0 + sum(B[q] @ x[t - 1 - q] for q in range(2))
+        v = b.copy()
+        for _ in range(10):
+            v = b + W.T @ _sigmoid(c + W @ v)
+        seen = ~missing[t]
+        sums[seen] += x[t, seen] - v[seen]
+        counts[seen] += 1
+        if missing[t].any():
+            start = np.where(missing[t], x[t - 1], x[t])
+            fill = b + W.T @ _sigmoid(c + W @ start)
+            fill += sums / np.maximum(counts + shrinkage, 1)
+            x[t] = np.where(missing[t], fill, x[t])
+    return x
+
+
+def test_matches_the_loop_written_out(model, data):
+    X, ids = data
+    X_missing = X[ids == 0].copy()
+    X_missing[8:, 1] = np.nan
+    X_missing[12:16, 2] = np.nan  # a gap: its residuals resume after it
+    imputer = CRBMImputer(
+        FrozenEstimator(model), n_gibbs=0, n_particles=1, offset_shrinkage=2.5
+    ).fit(X)
+    expected = reference_fill(model, X_missing, 2.5)
+    assert_allclose(imputer.transform(X_missing), expected, rtol=1e-10, atol=1e-12)
+    # and the correction does something: without it the fills differ
+    plain = imputer.set_params(offset_shrinkage=None).transform(X_missing)
+    assert np.abs(plain - expected)[8:, 1].max() > 1e-3
+
+
+def test_infinite_shrinkage_is_no_correction(model, data):
+    X, ids = data
+    X_missing = X[ids < 2].copy()
+    X_missing[20:, :2] = np.nan
+    imputer = CRBMImputer(
+        FrozenEstimator(model), n_gibbs=5, n_particles=3, random_state=0
+    )
+    imputer.fit(X)
+    plain = imputer.set_params(offset_shrinkage=None).transform(
+        X_missing, sequence_ids=ids[ids < 2]
+    )
+    huge = imputer.set_params(offset_shrinkage=1e12).transform(
+        X_missing, sequence_ids=ids[ids < 2]
+    )
+    assert_allclose(huge, plain, atol=1e-9)
+
+
+def test_keeps_a_shifted_channel_where_the_model_would_pull_it_back(model, data):
+    """A channel offset from every training sequence stays offset when lost."""
+    X, ids = data
+    X_test = X[ids == 4] + np.array([1.5, 0.0, 0.0])
+    X_missing = X_test.copy()
+    X_missing[20:, 0] = np.nan
+    errors = {}
+    for shrinkage in (None, 5.0):
+        imputer = CRBMImputer(
+            FrozenEstimator(model), offset_shrinkage=shrinkage, random_state=0
+        ).fit(X)
+        filled = imputer.transform(X_missing)
+        errors[shrinkage] = np.mean((filled - X_test)[20:, 0] ** 2)
+        # reproducible for a random_state
+        assert_array_equal(imputer.transform(X_missing), filled)
+    assert errors[5.0] < 0.5 * errors[None]
+
+
+def test_complete_frames_and_observed_values_are_untouched(model, data):
+    X, ids = data
+    X_missing = X[ids == 1].copy()
+    X_missing[15:, 2] = np.nan
+    filled = (
+        CRBMImputer(FrozenEstimator(model), random_state=0).fit(X).transform(X_missing)
+    )
+    observed = ~np.isnan(X_missing)
+    assert_array_equal(filled[observed], X_missing[observed])
+    assert np.isfinite(filled).all()
+
+
+def test_negative_shrinkage_is_rejected(data):
+    X, _ = data
+    imputer = CRBMImputer(ConditionalRBM(3, n_iter=1), offset_shrinkage=-1)
+    with pytest.raises(InvalidParameterError, match="offset_shrinkage"):
+        imputer.fit(X)

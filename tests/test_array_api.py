@@ -1,0 +1,331 @@
+"""ConditionalRBM under ``sklearn.set_config(array_api_dispatch=True)``.
+
+Every namespace and device available here (numpy, array-api-strict on its
+two devices, PyTorch on the CPU and on CUDA when present; PyTorch only when
+installed, see README) against the numpy path: the same fitted parameters
+give the same outputs within float tolerance; training and generation,
+whose random streams differ across namespaces, agree statistically and,
+where a namespace draws from numpy (array-api-strict), exactly when given
+the same stream.
+"""
+
+import importlib.util
+import pickle
+
+import numpy as np
+import pytest
+import sklearn
+from sklearn.utils._array_api import (
+    _convert_to_numpy,
+    get_namespace_and_device,
+    move_estimator_to,
+    yield_namespace_device_dtype_combinations,
+)
+from sklearn.utils._testing import _array_api_for_tests
+
+from sklearn_crbm import (
+    AutoregressiveImputer,
+    ConditionalRBM,
+    CRBMImputer,
+    NearestNeighborImputer,
+    StackedCRBM,
+)
+from sklearn_crbm._crbm_math import (
+    CRBMParameters,
+    MomentumUpdate,
+    cd_gradients,
+    dynamic_biases,
+    gibbs_frames,
+)
+from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.utils._array_api import ArrayRandom, array_ops
+
+
+def _available(namespace, device):
+    if namespace not in ("numpy", "array_api_strict", "torch"):
+        return False  # cupy, dpnp: not installed on the test machines
+    if importlib.util.find_spec(namespace) is None:
+        return False
+    if namespace == "torch":
+        import torch
+
+        return device == "cpu" or (device == "cuda" and torch.cuda.is_available())
+    return True
+
+
+COMBINATIONS = [
+    combination
+    for combination in yield_namespace_device_dtype_combinations()
+    if _available(*combination[:2])
+]
+# The namespaces other than numpy itself
+DEVICE_COMBINATIONS = [c for c in COMBINATIONS if c[0] != "numpy"]
+
+
+@pytest.fixture
+def dispatch():
+    with sklearn.config_context(array_api_dispatch=True):
+        yield
+
+
+def _data(dtype_name):
+    X, ids = make_oscillations(n_sequences=4, n_frames=40, random_state=0)
+    return X.astype(dtype_name or "float64"), ids
+
+
+def _to(xp, device, array):
+    return xp.asarray(array, device=device)
+
+
+def _numpy(array):
+    return _convert_to_numpy(array, get_namespace_and_device(array)[0])
+
+
+def _same_place(array, reference):
+    """``array`` has the namespace, device and dtype of ``reference``."""
+    array_xp, _, array_device = get_namespace_and_device(array)
+    xp, _, device = get_namespace_and_device(reference)
+    assert array_xp == xp
+    assert array_device == device
+    assert array.dtype == reference.dtype
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", COMBINATIONS)
+def test_fitted_attributes_and_outputs_live_on_the_input_device(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    X_xp = _to(xp, device, X)
+    model = ConditionalRBM(6, order=2, n_iter=2, random_state=0)
+    model.fit(X_xp, sequence_ids=ids)
+    for name in (
+        "components_",
+        "intercept_hidden_",
+        "intercept_visible_",
+        "autoregressive_",
+        "past_to_hidden_",
+        "visible_variance_",
+        "seed_windows_",
+    ):
+        _same_place(getattr(model, name), X_xp)
+    model.partial_fit(X_xp, sequence_ids=ids)
+    assert model.n_iter_ == 3
+    for output in (
+        model.transform(X_xp, sequence_ids=ids),
+        model.predict_next(X_xp, sequence_ids=ids),
+        model.score_samples(X_xp, sequence_ids=ids),
+        model.sample(4, n_sequences=3, random_state=0),
+        model.sample(4, history=X_xp[:2, ...], random_state=0),
+    ):
+        _same_place(output, X_xp)
+    assert np.isfinite(model.score(X_xp, sequence_ids=ids))
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+@pytest.mark.parametrize("n_components", [6, 30])  # exact score; annealed score
+@pytest.mark.parametrize("visible_variance", ["unit", "learned"])
+def test_fitted_numpy_model_gives_the_same_outputs(
+    namespace, device_name, dtype_name, n_components, visible_variance, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    with sklearn.config_context(array_api_dispatch=False):
+        model = ConditionalRBM(
+            n_components,
+            order=2,
+            hidden_order=1,
+            visible_variance=visible_variance,
+            n_iter=5,
+            random_state=0,
+        ).fit(X, sequence_ids=ids)
+    moved = move_estimator_to(model, xp, device)
+    X_xp = _to(xp, device, X)
+    rtol = 1e-4 if dtype_name == "float32" else 1e-10
+    for method in ("transform", "predict_next"):
+        expected = getattr(model, method)(X, sequence_ids=ids)
+        got = _numpy(getattr(moved, method)(X_xp, sequence_ids=ids))
+        np.testing.assert_allclose(got, expected, rtol=rtol, atol=rtol)
+    expected = model.score_samples(X, sequence_ids=ids)
+    got = _numpy(moved.score_samples(X_xp, sequence_ids=ids))
+    if n_components == 6:  # exact: the same numbers
+        np.testing.assert_allclose(got, expected, rtol=rtol, atol=rtol)
+    else:  # annealed with other random numbers: within its own error
+        error = model.estimate_log_likelihood(X, sequence_ids=ids, reverse=False)
+        assert np.abs(got - expected).max() < 10 * error.standard_error.max() + rtol
+        assert abs(got.mean() - expected.mean()) < 0.01
+    # and back to numpy: the same model again
+    back = move_estimator_to(moved, np, None)
+    np.testing.assert_array_equal(back.components_, model.components_)
+    np.testing.assert_array_equal(back.autoregressive_, model.autoregressive_)
+    # the moved model has its own parameters: training it leaves the original
+    before = model.components_.copy()
+    moved.partial_fit(X_xp, sequence_ids=ids)
+    np.testing.assert_array_equal(model.components_, before)
+
+
+def _strict_and_numpy_streams(seed, ops):
+    # array-api-strict draws with numpy: the same seed gives the same numbers
+    return ArrayRandom(seed, ops), np.random.default_rng(seed)
+
+
+def test_training_step_matches_numpy_given_the_same_random_stream():
+    xp, device = _array_api_for_tests("array_api_strict", "CPU_DEVICE", "float64")
+    rng = np.random.default_rng(0)
+    params = CRBMParameters.initialize(
+        5, 7, 2, 1, "gaussian", np.float64, rng, learned_variance=True
+    )
+    moved = params.__sklearn_array_api_convert__(lambda a: _to(xp, device, a))
+    visible = rng.standard_normal((20, 5))
+    history = rng.standard_normal((20, 10))
+    ops = array_ops(moved.flat)
+    device_rng, numpy_rng = _strict_and_numpy_streams(1, ops)
+    results = []
+    for p, v, h, r in (
+        (params, visible, history, numpy_rng),
+        (moved, _to(xp, device, visible), _to(xp, device, history), device_rng),
+    ):
+        update = MomentumUpdate(p)
+        _, error = cd_gradients(p, v, h, 2, r, out=update.statistics, scale=0.01)
+        update.apply(0.5, 0.01, 0.001)
+        update.apply(0.5, 0.01, 0.001)  # with momentum
+        results.append((p.flat, float(error)))
+    np.testing.assert_allclose(_numpy(results[1][0]), results[0][0], rtol=1e-12)
+    assert results[1][1] == pytest.approx(results[0][1], rel=1e-12)
+
+
+def test_gibbs_sampling_matches_numpy_given_the_same_random_stream():
+    xp, device = _array_api_for_tests("array_api_strict", "CPU_DEVICE", "float64")
+    rng = np.random.default_rng(0)
+    params = CRBMParameters.initialize(4, 6, 1, 1, "gaussian", np.float64, rng)
+    moved = params.__sklearn_array_api_convert__(lambda a: _to(xp, device, a))
+    start = rng.standard_normal((8, 4))
+    history = rng.standard_normal((8, 4))
+    ops = array_ops(moved.flat)
+    device_rng, numpy_rng = _strict_and_numpy_streams(2, ops)
+    frames = []
+    for p, s, h, r in (
+        (params, start, history, numpy_rng),
+        (moved, _to(xp, device, start), _to(xp, device, history), device_rng),
+    ):
+        visible_bias, hidden_bias = dynamic_biases(p, h)
+        frames.append(
+            gibbs_frames(p, s, visible_bias, hidden_bias, 5, r, hidden_noise=0.3)
+        )
+    np.testing.assert_allclose(_numpy(frames[1]), frames[0], rtol=1e-12)
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_training_and_generation_agree_with_numpy_statistically(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    settings = dict(order=2, n_iter=30, learning_rate=1e-2, random_state=0)
+    with sklearn.config_context(array_api_dispatch=False):
+        model = ConditionalRBM(6, **settings).fit(X, sequence_ids=ids)
+        expected_score = model.score(X, sequence_ids=ids)
+        expected_frames = model.sample(20, n_sequences=100, random_state=0)
+    trained = ConditionalRBM(6, **settings).fit(_to(xp, device, X), sequence_ids=ids)
+    # the same start parameters, other random numbers: the same quality
+    # (across training seeds the last epoch's error spreads by about 20%
+    # and the score by about 0.03 nats)
+    assert trained.reconstruction_error_ == pytest.approx(
+        model.reconstruction_error_, rel=0.3
+    )
+    score = trained.score(_to(xp, device, X), sequence_ids=ids)
+    assert abs(score - expected_score) < 0.06
+    # generation from the numpy model moved over: the same distribution
+    frames = _numpy(move_estimator_to(model, xp, device).sample(20, n_sequences=100))
+    assert frames.shape == expected_frames.shape
+    spread = expected_frames.std(axis=0)
+    np.testing.assert_array_less(
+        np.abs(frames.mean(axis=0) - expected_frames.mean(axis=0)), 0.2 * spread
+    )
+    np.testing.assert_allclose(frames.std(axis=0), spread, rtol=0.2)
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_pickling_keeps_the_namespace_and_moving_to_numpy_keeps_the_model(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    X_xp = _to(xp, device, X)
+    model = ConditionalRBM(6, order=2, n_iter=2, random_state=0)
+    model.fit(X_xp, sequence_ids=ids)
+    expected = _numpy(model.transform(X_xp, sequence_ids=ids))
+    loaded = pickle.loads(pickle.dumps(model))
+    _same_place(loaded.components_, X_xp)
+    np.testing.assert_array_equal(
+        _numpy(loaded.transform(X_xp, sequence_ids=ids)), expected
+    )
+    on_numpy = pickle.loads(pickle.dumps(move_estimator_to(model, np, None)))
+    with sklearn.config_context(array_api_dispatch=False):
+        np.testing.assert_allclose(
+            on_numpy.transform(X, sequence_ids=ids), expected, rtol=1e-5, atol=1e-6
+        )
+        on_numpy.partial_fit(X, sequence_ids=ids)  # and trains on
+    assert isinstance(on_numpy.components_, np.ndarray)
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_input_of_another_namespace_is_a_clear_error(
+    namespace, device_name, dtype_name
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    with sklearn.config_context(array_api_dispatch=True):
+        model = ConditionalRBM(6, order=2, n_iter=2, random_state=0)
+        model.fit(_to(xp, device, X), sequence_ids=ids)
+        with pytest.raises(ValueError, match="same namespace"):
+            model.transform(X, sequence_ids=ids)
+    with pytest.raises(ValueError, match="array_api_dispatch=True"):
+        model.score(X, sequence_ids=ids)
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+@pytest.mark.parametrize(
+    "imputer", [CRBMImputer, AutoregressiveImputer, NearestNeighborImputer]
+)
+def test_imputers_refuse_other_namespaces_clearly(
+    namespace, device_name, dtype_name, imputer, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    with pytest.raises(TypeError, match="fills numpy arrays only"):
+        imputer().fit(_to(xp, device, X))
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_stack_fits_and_runs_on_the_input_device_as_on_numpy(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    X_xp = _to(xp, device, X)
+    settings = dict(order=2, n_iter=3, random_state=0)
+    stack = StackedCRBM((8, 6), **settings).fit(X_xp, sequence_ids=ids)
+    stack.partial_fit(X_xp, sequence_ids=ids)
+    for layer in stack.layers_:
+        _same_place(layer.components_, X_xp)
+    for output in (
+        stack.transform(X_xp, sequence_ids=ids),
+        stack.score_samples(X_xp, sequence_ids=ids),
+        stack.sample(4, n_sequences=2, random_state=0),
+    ):
+        _same_place(output, X_xp)
+    with sklearn.config_context(array_api_dispatch=False):
+        model = StackedCRBM((8, 6), **settings).fit(X, sequence_ids=ids)
+        expected_score = model.score(X, sequence_ids=ids)
+    moved = move_estimator_to(model, xp, device)
+    rtol = 1e-4 if dtype_name == "float32" else 1e-10
+    for method in ("transform", "predict_next"):
+        np.testing.assert_allclose(
+            _numpy(getattr(moved, method)(X_xp, sequence_ids=ids)),
+            getattr(model, method)(X, sequence_ids=ids),
+            rtol=rtol,
+            atol=rtol,
+        )
+    # a bound from ten draws per frame: other draws, nearly the same mean
+    assert abs(moved.score(X_xp, sequence_ids=ids) - expected_score) < 0.05
