@@ -560,12 +560,13 @@ class ConditionalRBM(BaseCRBM):
         fit = ridge_autoregression(
             X.astype(np.float64), frames, self.order, _AUTOREGRESSIVE_ALPHA
         )
-        self.autoregressive_ = fit.coef
-        self.intercept_visible_ = fit.intercept
+        self.autoregressive_ = fit.coef.astype(X.dtype)
+        self.intercept_visible_ = fit.intercept.astype(X.dtype)
         if self._parameters.learned_variance:
+            variance = np.mean(np.square(fit.residual), axis=0)
             self.visible_variance_ = np.maximum(
-                np.mean(np.square(fit.residual), axis=0), np.exp(MIN_LOG_VARIANCE)
-            )
+                variance, np.exp(MIN_LOG_VARIANCE)
+            ).astype(X.dtype)
 
     # Diverging weights overflow in the products before the epoch's check
     # raises TrainingDivergedError, which says what to do.
