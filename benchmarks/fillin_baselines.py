@@ -16,8 +16,11 @@ Protocol (the paper's §4.4, as ``paper_fillin.py``, with a second split):
   ``ConditionalRBM.paper_schedule(n_iter=1000)``, ``ar-init`` the defaults
   with ``init="autoregressive"`` and ``ar-init-learned`` that with
   ``visible_variance="learned"`` and ``cd_steps=5`` (both with
-  ``--ar-history-noise`` if given); ``transform`` is
-  called once, as a user would;
+  ``--ar-history-noise`` if given); ``transform`` is called once, as a
+  user would.  Each model also fills with the paper's on-line procedure
+  (``--fillins paper``: one chain, no offset correction,
+  ``CRBMImputer(n_particles=1, offset_shrinkage=None)``), the defaults
+  before the offset correction;
 - error: the paper's (per-frame mean squared error over the erased
   channels, summed over the erased frames, z-scored units).
 
@@ -55,6 +58,9 @@ from sklearn_crbm.metrics import fillin_error  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 PAPER = {"walk/leg": (8.78, 11.68), "walk/upper": (20.52, 22.20)}
+# CRBMImputer settings a model fills with; the rows of "paper" are named
+# "<model>, paper's fill-in".
+FILLINS = {"default": {}, "paper": dict(n_particles=1, offset_shrinkage=None)}
 
 
 def baselines():
@@ -119,6 +125,9 @@ def main(argv=None):
         default=["default", "paper"],
         choices=["default", "paper", "ar-init", "ar-init-learned"],
     )
+    parser.add_argument(
+        "--fillins", nargs="+", default=list(FILLINS), choices=list(FILLINS)
+    )
     parser.add_argument("--n-iter", type=int, default=1000)
     parser.add_argument("--ar-history-noise", type=float, default=None)
     parser.add_argument(
@@ -149,7 +158,10 @@ def main(argv=None):
                     args.n_iter,
                     args.ar_history_noise,
                 )
-                crbm.setdefault(model, {})[seed] = errors(imputer, split)
+                for fillin in args.fillins:
+                    row = model if fillin == "default" else f"{model}, paper's fill-in"
+                    imputer.set_params(**FILLINS[fillin])
+                    crbm.setdefault(row, {})[seed] = errors(imputer, split)
                 print(
                     f"  {split_name} {model} seed {seed}: trained in {seconds:.0f} s",
                     flush=True,
@@ -177,23 +189,23 @@ def report(split_name, trials, base, best, crbm):
         f"\nSplit '{split_name}' (walk {trials[0]}, jog {trials[1]} held out): "
         "the paper's error, lower is better"
     )
-    header = f"| {'method':34s} |" + "".join(f" {c:>10s} |" for c in CELLS)
+    header = f"| {'method':50s} |" + "".join(f" {c:>10s} |" for c in CELLS)
     print(header)
-    print("|" + "-" * 36 + "|" + "------------|" * len(CELLS))
+    print("|" + "-" * 52 + "|" + "------------|" * len(CELLS))
     if split_name == "paper":
         cells = [
             f"{PAPER[c][0]:.2f}/{PAPER[c][1]:.2f}" if c in PAPER else "-" for c in CELLS
         ]
         print(
-            f"| {'paper: CRBM/nearest neighbour':34s} |"
+            f"| {'paper: CRBM/nearest neighbour':50s} |"
             + "".join(f" {cell:>10s} |" for cell in cells)
         )
     for name, row in base.items():
-        print(f"| {name:34s} |" + "".join(f" {row[c]:>10.2f} |" for c in CELLS))
+        print(f"| {name:50s} |" + "".join(f" {row[c]:>10.2f} |" for c in CELLS))
     for model, per_seed in crbm.items():
         for seed, row in per_seed.items():
             print(
-                f"| {f'CRBM {model}, seed {seed}':34s} |"
+                f"| {f'CRBM {model}, seed {seed}':50s} |"
                 + "".join(
                     f" {('**' if row[c] < best[c] else '') + format(row[c], '.2f'):>10s} |"
                     for c in CELLS
@@ -201,7 +213,7 @@ def report(split_name, trials, base, best, crbm):
             )
         wins = {c: sum(row[c] < best[c] for row in per_seed.values()) for c in CELLS}
         print(
-            f"| {f'CRBM {model}: seeds beating all':34s} |"
+            f"| {f'CRBM {model}: seeds beating all':50s} |"
             + "".join(f" {f'{wins[c]}/{len(per_seed)}':>10s} |" for c in CELLS)
         )
 
