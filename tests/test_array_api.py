@@ -329,3 +329,23 @@ def test_stack_fits_and_runs_on_the_input_device_as_on_numpy(
         )
     # a bound from ten draws per frame: other draws, nearly the same mean
     assert abs(moved.score(X_xp, sequence_ids=ids) - expected_score) < 0.05
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_autoregressive_start_lands_on_the_input_device(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    settings = dict(order=2, n_iter=1, init="autoregressive", random_state=0)
+    settings["visible_variance"] = "learned"
+    X_xp = _to(xp, device, X)
+    model = ConditionalRBM(6, **settings).fit(X_xp, sequence_ids=ids)
+    with sklearn.config_context(array_api_dispatch=False):
+        expected = ConditionalRBM(6, **settings).fit(X, sequence_ids=ids)
+    for name in ("autoregressive_", "intercept_visible_", "visible_variance_"):
+        _same_place(getattr(model, name), X_xp)
+        # the same ridge start; one epoch of other random numbers moves it little
+        np.testing.assert_allclose(
+            _numpy(getattr(model, name)), getattr(expected, name), atol=2e-3
+        )
