@@ -167,7 +167,8 @@ def cpu_rows(args, X, ids, dtype, threads):
                     ),
                 )
                 products = min(
-                    products, timed(lambda: products_only_epoch(buffers, sizes))
+                    products,
+                    timed(lambda b=buffers, s=sizes: products_only_epoch(b, s)),
                 )
             peak = peak_mb(
                 lambda b=batch_size: model(args, b).partial_fit(
@@ -385,8 +386,12 @@ def main(argv=None):
     else:
         print_table(
             gains,
-            [("task", "task", ""), ("dtype", "dtype", ""), ("batch", "batch", "d"),
-             ("speedup", "GPU / best CPU", ".1f")],
+            [
+                ("task", "task", ""),
+                ("dtype", "dtype", ""),
+                ("batch", "batch", "d"),
+                ("speedup", "GPU / best CPU", ".1f"),
+            ],
         )
     write_json(
         "bench_large",

@@ -298,9 +298,7 @@ class CRBMParameters:
     @property
     def decayed(self):
         """The prefix of :attr:`flat` that weight decay applies to."""
-        size = sum(
-            math.prod(getattr(self, g.name).shape) for g in GROUPS if g.decayed
-        )
+        size = sum(math.prod(getattr(self, g.name).shape) for g in GROUPS if g.decayed)
         return slice(0, size)
 
     @classmethod
@@ -783,7 +781,10 @@ def cd_gradients(
     stacked_visible = workspace.visible_stack[: 2 * n, ...]
     stacked_hidden = workspace.hidden_stack[: 2 * n, ...]
     data, reconstruction = stacked_visible[:n, ...], stacked_visible[n:, ...]
-    positive_states, negative_probabilities = stacked_hidden[:n, ...], stacked_hidden[n:, ...]
+    positive_states, negative_probabilities = (
+        stacked_hidden[:n, ...],
+        stacked_hidden[n:, ...],
+    )
     if not same_memory(visible, data):
         ops.copyto(data, visible)
 
@@ -799,7 +800,9 @@ def cd_gradients(
     for step in range(cd_steps):
         visible_means(params, hidden, visible_bias, out=reconstruction)
         if learned and step == 0:
-            ops.subtract(reconstruction, visible_bias, out=workspace.first_mean[:n, ...])
+            ops.subtract(
+                reconstruction, visible_bias, out=workspace.first_mean[:n, ...]
+            )
         if step + 1 < cd_steps:
             with np.errstate(over="ignore", under="ignore", invalid="ignore"):
                 hidden = sample_hidden(
