@@ -77,14 +77,16 @@ class CRBMImputer(
         (still several times real time).
     offset_shrinkage : float or None, default=30.0
         Correct each fill for the model's systematic error on the sequence
-        at hand (see Notes).  ``None`` is the paper's procedure, without
-        correction (with ``n_particles=1``: the paper's fill-in exactly).  A number ``lam >= 0``: a missing entry of channel
-        ``j`` is shifted by ``sum(r) / (n + lam)``, where ``r`` are the
-        channel's one-step residuals (observed value minus the chain's
-        mean-field prediction from its past) over the ``n`` frames of the
-        sequence in which it was observed so far: the mean residual, shrunk
-        towards 0 as if ``lam`` frames of zero residual had been seen.
-        ``30`` suits CMU subject 35 at 30 frames per second (see Notes).
+        at hand (see Notes).  ``None``: no correction (with
+        ``n_particles=1``, the paper's fill-in exactly).  A number ``lam >=
+        0``: a missing entry of channel ``j`` is shifted by ``sum(r) / (n +
+        lam)``, where ``r`` are the channel's one-step residuals (observed
+        value minus the chain's mean-field prediction from its past) over
+        the ``n`` frames of the sequence in which it was observed so far:
+        the mean residual, shrunk towards 0 as if ``lam`` frames of zero
+        residual had been seen.  Binary visibles' fills are probabilities
+        and are kept in [0, 1].  ``30`` suits CMU subject 35 at 30 frames
+        per second (see Notes).
     missing_values : int, float, str, np.nan or None, default=np.nan
         The placeholder for missing values; all its occurrences are filled.
     random_state : int, RandomState instance or None, default=None
