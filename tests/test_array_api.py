@@ -15,6 +15,7 @@ import pickle
 import numpy as np
 import pytest
 import sklearn
+from sklearn.frozen import FrozenEstimator
 from sklearn.utils._array_api import (
     _convert_to_numpy,
     get_namespace_and_device,
@@ -388,3 +389,23 @@ def test_early_stopping_validates_on_the_input_device(
         model.validation_scores_, expected.validation_scores_, atol=0.05
     )
     _same_place(model.components_, _to(xp, device, X))
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_imputer_refuses_a_frozen_model_of_another_namespace_clearly(
+    namespace, device_name, dtype_name
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    with sklearn.config_context(array_api_dispatch=True):
+        model = ConditionalRBM(6, order=2, n_iter=1, random_state=0)
+        model.fit(_to(xp, device, X), sequence_ids=ids)
+    imputer = CRBMImputer(FrozenEstimator(model))
+    with pytest.raises(TypeError, match="move_estimator_to"):
+        imputer.fit(X, sequence_ids=ids)
+    # moved to numpy, the same model fills
+    imputer = CRBMImputer(FrozenEstimator(move_estimator_to(model, np, None)))
+    X_missing = X.copy()
+    X_missing[5:9, 1] = np.nan
+    filled = imputer.fit(X, sequence_ids=ids).transform(X_missing, sequence_ids=ids)
+    assert np.isfinite(filled).all()
