@@ -98,10 +98,12 @@ def standard_normal(rng, shape, dtype, out=None):
     noise of every training minibatch is that many draws.  Its tails stop at
     ``sqrt(46 log 2) = 5.65`` standard deviations (probability 2e-8 beyond).
     """
-    if not isinstance(rng, np.random.Generator) or np.dtype(dtype) != np.float32:
-        return rng.standard_normal(shape, dtype=dtype, out=out)
     size = math.prod(shape)
-    if size < _MIN_BIT_DRAWS:
+    if (
+        not isinstance(rng, np.random.Generator)
+        or np.dtype(dtype) != np.float32
+        or size < _MIN_BIT_DRAWS
+    ):
         return rng.standard_normal(shape, dtype=dtype, out=out)
     half = (size + 1) // 2
     radius, angle = uniform(rng, (2, half), np.float32)
