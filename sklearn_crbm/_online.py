@@ -17,6 +17,7 @@ gives the dynamic biases of the next frame.
 from dataclasses import dataclass
 
 import numpy as np
+from sklearn.utils._array_api import _convert_to_numpy
 
 from ._crbm_math import (
     BINARY,
@@ -175,8 +176,12 @@ class History:
     def reorder(self, chains, sequences):
         """Give chain ``i`` of each of ``sequences`` the past of chain ``chains[i]``.
 
-        ``chains`` has shape ``(n_chains, len(sequences))``.
+        ``chains`` has shape ``(n_chains, len(sequences))``; off numpy,
+        ``sequences`` is every sequence (a slice).
         """
+        if self._ops is not np:
+            self.windows = [_take_chains(self._ops, w, chains) for w in self.windows]
+            return
         for window in self.windows:
             window[:, sequences] = window[chains, sequences[None, :]]
 
@@ -226,29 +231,38 @@ class Offsets:
     """
 
     def __init__(self, n_chains, n_sequences, bottom, shrinkage, *, dtype):
-        self.sums = np.zeros((n_chains, n_sequences, bottom.n_features), dtype)
-        self.counts = np.zeros((n_sequences, bottom.n_features), dtype)
+        self._ops = ops = bottom.ops
+        self.sums = ops.zeros((n_chains, n_sequences, bottom.n_features), dtype)
+        self.counts = ops.zeros((n_sequences, bottom.n_features), dtype)
         self.shrinkage = shrinkage
         self.binary = bottom.visible_type == BINARY
 
     def update(self, layers, biases, sequences, frames, observed):
         """Add the residuals of ``frames`` (one per sequence) where ``observed``."""
+        ops = self._ops
         n_chains = self.sums.shape[0]
-        prediction = stacked_prediction(
-            layers, *_split(layers, biases), PREDICTION_STEPS
-        ).reshape(n_chains, *frames.shape)
-        self.sums[:, sequences] += np.where(observed, frames - prediction, 0)
-        self.counts[sequences] += observed
+        prediction = ops.reshape(
+            stacked_prediction(layers, *_split(layers, biases), PREDICTION_STEPS),
+            (n_chains, *frames.shape),
+        )
+        self.sums[:, sequences, ...] += ops.where(observed, frames - prediction, 0)
+        self.counts[sequences, ...] += ops.astype(observed, self.counts.dtype)
 
     def corrected(self, frames, sequences, missing):
         """Every chain's ``frames`` of ``sequences``, corrected where ``missing``."""
+        ops = self._ops
         # a channel never observed has a zero sum; the floor spares 0 / 0
-        denominator = np.maximum(self.counts[sequences] + self.shrinkage, 1)
-        frames = frames + np.where(missing, self.sums[:, sequences] / denominator, 0)
-        return np.clip(frames, 0, 1, out=frames) if self.binary else frames
+        denominator = ops.maximum(self.counts[sequences, ...] + self.shrinkage, 1)
+        frames = frames + ops.where(
+            missing, self.sums[:, sequences, ...] / denominator, 0
+        )
+        return ops.clip(frames, 0, 1) if self.binary else frames
 
     def reorder(self, chains, sequences):
         """The chains' offsets follow their pasts (:meth:`History.reorder`)."""
+        if self._ops is not np:
+            self.sums = _take_chains(self._ops, self.sums, chains)
+            return
         self.sums[:, sequences] = self.sums[chains, sequences[None, :]]
 
 
@@ -328,6 +342,14 @@ def run_online(
         Indices into ``sequences`` of the frames that were drawn.
     frames : ndarray of shape (n_chains, len(drawn), n_features)
         Every chain's draw of those frames (observed entries included).
+
+    Notes
+    -----
+    In fill-in on an array API namespace other than numpy
+    (:func:`_fill_on_device`), every sequence advances at every step, so that
+    nothing is scattered on the device: ``sequences`` and ``drawn`` are all
+    sequences, a sequence that has ended repeats its last frame (a draw to
+    ignore), and a frame without a missing entry comes back as it is.
     """
     if scheme not in (TOP_LAYER, WHOLE_STACK):
         raise ValueError(f"unknown scheme {scheme!r}")
@@ -399,6 +421,20 @@ def run_online(
         offsets = Offsets(
             n_chains, len(starts), layers[0], offset_shrinkage, dtype=X.dtype
         )
+    if ops is not np:
+        yield from _fill_on_device(
+            layers,
+            rng,
+            draw,
+            history,
+            observed,
+            n_steps,
+            n_chains=n_chains,
+            n_particles=n_particles,
+            offsets=offsets,
+            start_jitter=start_jitter,
+        )
+        return
     for step in range(n_steps):
         sequences = np.flatnonzero(lengths > step)
         rows = starts[sequences] + step
@@ -421,7 +457,7 @@ def run_online(
             yield step, sequences, drawn, current[:, drawn]
             continue
         if n_particles > 1 and len(drawn):
-            chains = _resample(
+            chains = _ancestors(
                 history,
                 sequences[drawn],
                 frames[drawn],
@@ -429,6 +465,7 @@ def run_online(
                 n_particles,
                 rng,
             )
+            history.reorder(chains, sequences[drawn])
             if offsets is not None:
                 offsets.reorder(chains, sequences[drawn])
         biases = history.biases(sequences)
@@ -451,42 +488,124 @@ def run_online(
         history.push([current], sequences, biases)
 
 
-def _resample(history, sequences, frames, observed, n_particles, rng):
+def _fill_on_device(
+    layers,
+    rng,
+    draw,
+    history,
+    observed,
+    n_steps,
+    *,
+    n_chains,
+    n_particles,
+    offsets,
+    start_jitter,
+):
+    """The fill-in loop of :func:`run_online` off numpy: every sequence, every step.
+
+    The same procedure as the numpy loop, written without scattering into
+    device arrays: every sequence draws every step (a sequence that has ended
+    repeats its last frame), a frame with nothing missing is clamped whole
+    and comes back unchanged (its offset correction is zero where nothing is
+    missing), and only groups of particles whose frame has a missing entry
+    are resampled.  The numpy loop skips those draws, so the random streams
+    differ; the fills agree in distribution.
+    """
+    ops = layers[0].ops
+    X, missing, sequences = observed.X, observed.missing, observed.sequences
+    starts, lengths = sequences.starts, sequences.lengths
+    every = slice(None)
+    all_sequences = np.arange(len(starts))
+    has_missing = _convert_to_numpy(ops.any(missing, axis=1), ops.xp)
+    for step in range(n_steps):
+        rows = starts + np.minimum(step, lengths - 1)
+        frame_missing = ops.take(missing, rows, axis=0)
+        frames = ops.take(X, rows, axis=0)
+        shape = (n_chains, *frames.shape)
+        clamp = ops.broadcast_to(~frame_missing, shape)
+        current = ops.broadcast_to(frames, shape)
+        if history is None:
+            for _ in range(FIRST_FRAME_ROUNDS):
+                own_past = History.from_frames(layers, current[:, :, None, :])
+                current = draw(current, own_past.biases(every), clamp)[0]
+            history = History.from_frames(layers, current[:, :, None, :])
+            yield step, all_sequences, all_sequences, current
+            continue
+        if n_particles > 1:
+            chains = _ancestors(
+                history, every, frames, ~frame_missing, n_particles, rng
+            )
+            drawn = ops.asarray(has_missing[rows] & (lengths > step))
+            chains = ops.where(
+                drawn[None, :], chains, ops.arange(n_chains, dtype=ops.int64)[:, None]
+            )
+            history.reorder(chains, every)
+            if offsets is not None:
+                offsets.reorder(chains, every)
+        biases = history.biases(every)
+        if offsets is not None and step >= layers[0].n_lags:
+            offsets.update(layers, biases, every, frames, ~frame_missing)
+        start = ops.where(frame_missing, history.previous(0, every), frames)
+        if start_jitter:
+            start = start + start_jitter * rng.standard_normal(start.shape, start.dtype)
+        current = draw(start, biases, clamp)[0]
+        if offsets is not None:
+            current = offsets.corrected(current, every, frame_missing)
+        yield step, all_sequences, all_sequences, current
+        history.push([current], every, biases)
+
+
+def _ancestors(history, sequences, frames, observed, n_particles, rng):
     """Resample each group of particles by how well they explain the observed data.
 
     A particle's weight is the likelihood of the frame's observed channels
     under its own one-step prediction
     (:func:`~sklearn_crbm._crbm_math.observed_log_likelihood`); each group is
-    resampled (systematic resampling) and the pasts of the chosen ancestors
-    copied, before the frame is drawn.  Returns the ancestors, as
-    :meth:`History.reorder` takes them.
+    resampled (systematic resampling).  Returns the ancestors, of shape
+    ``(n_chains, n_sequences)``, as :meth:`History.reorder` takes them.
     """
     layers = history.layers
+    ops = layers[0].ops
     n_chains = history.windows[0].shape[0]
     n_groups = n_chains // n_particles
-    n_features = frames.shape[1]
+    n_sequences, n_features = frames.shape
     prediction = stacked_prediction(
         layers, *_split(layers, history.biases(sequences)), PREDICTION_STEPS
     )
     log_weights = observed_log_likelihood(
         layers[0],
         prediction,
-        np.broadcast_to(frames, (n_chains, *frames.shape)).reshape(-1, n_features),
-        np.broadcast_to(observed, (n_chains, *observed.shape)).reshape(-1, n_features),
-    ).reshape(n_groups, n_particles, len(sequences))
-    log_weights -= log_weights.max(axis=1, keepdims=True)
-    cumulative = np.cumsum(np.exp(log_weights), axis=1)
-    cumulative /= cumulative[:, -1:]
+        ops.reshape(
+            ops.broadcast_to(frames, (n_chains, *frames.shape)), (-1, n_features)
+        ),
+        ops.reshape(
+            ops.broadcast_to(observed, (n_chains, *observed.shape)), (-1, n_features)
+        ),
+    )
+    log_weights = ops.reshape(log_weights, (n_groups, n_particles, n_sequences))
+    log_weights = log_weights - ops.max(log_weights, axis=1, keepdims=True)
+    cumulative = ops.cumsum(ops.exp(log_weights), axis=1)
+    cumulative = cumulative / cumulative[:, -1:, ...]
     positions = (
-        rng.random((n_groups, 1, len(sequences))) + np.arange(n_particles)[:, None]
+        rng.random((n_groups, 1, n_sequences))
+        + ops.arange(n_particles, dtype=ops.float64)[:, None]
     ) / n_particles
     # ancestor of particle i: how many cumulative weights lie below position i
-    ancestors = (cumulative[:, None, :, :] < positions[:, :, None, :]).sum(axis=2)
-    np.minimum(ancestors, n_particles - 1, out=ancestors)
-    chains = ancestors + (np.arange(n_groups) * n_particles)[:, None, None]
-    chains = chains.reshape(n_chains, len(sequences))
-    history.reorder(chains, sequences)
-    return chains
+    below = cumulative[:, None, :, :] < positions[:, :, None, :]
+    ancestors = ops.sum(ops.astype(below, ops.int64), axis=2)
+    ancestors = ops.minimum(ancestors, n_particles - 1)
+    chains = (
+        ancestors + (ops.arange(n_groups, dtype=ops.int64) * n_particles)[:, None, None]
+    )
+    return ops.reshape(chains, (n_chains, n_sequences))
+
+
+def _take_chains(ops, array, chains):
+    """``array[chains[i, s], s]`` for every chain ``i`` and sequence ``s``."""
+    n_chains, n_sequences = chains.shape
+    flat = ops.reshape(array, (n_chains * n_sequences, -1))
+    index = chains * n_sequences + ops.arange(n_sequences, dtype=ops.int64)
+    return ops.reshape(ops.take(flat, ops.reshape(index, (-1,)), axis=0), array.shape)
 
 
 def _split(layers, biases):

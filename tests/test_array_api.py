@@ -11,6 +11,7 @@ the same stream.
 
 import importlib.util
 import pickle
+from functools import partial
 
 import numpy as np
 import pytest
@@ -38,6 +39,7 @@ from sklearn_crbm._crbm_math import (
     dynamic_biases,
     gibbs_frames,
 )
+from sklearn_crbm._online import History, _ancestors
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.utils._array_api import ArrayRandom, array_ops
 
@@ -286,9 +288,7 @@ def test_input_of_another_namespace_is_a_clear_error(
 
 
 @pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
-@pytest.mark.parametrize(
-    "imputer", [CRBMImputer, AutoregressiveImputer, NearestNeighborImputer]
-)
+@pytest.mark.parametrize("imputer", [AutoregressiveImputer, NearestNeighborImputer])
 def test_imputers_refuse_other_namespaces_clearly(
     namespace, device_name, dtype_name, imputer, dispatch
 ):
@@ -296,6 +296,152 @@ def test_imputers_refuse_other_namespaces_clearly(
     X, ids = _data(dtype_name)
     with pytest.raises(TypeError, match="fills numpy arrays only"):
         imputer().fit(_to(xp, device, X))
+
+
+def _imputer_data(dtype_name):
+    """Training data, and its last sequence with channels and frames missing."""
+    X, ids = _data(dtype_name)
+    X_missing = X[ids == 3].copy()
+    X_missing[10:, :2] = np.nan  # two channels lost
+    X_missing[20:24, :] = np.nan  # wholly missing frames
+    X_missing[0, 3] = np.nan  # in the first frame
+    return X, ids, X_missing
+
+
+def _moved_imputers(xp, device, X, ids, model, **params):
+    """A numpy imputer around ``model`` and the same on ``xp``'s ``device``."""
+    imputer = CRBMImputer(FrozenEstimator(model), random_state=0, **params)
+    moved = move_estimator_to(model, xp, device)
+    on_device = CRBMImputer(FrozenEstimator(moved), random_state=0, **params)
+    on_device.fit(_to(xp, device, X), sequence_ids=ids)
+    with sklearn.config_context(array_api_dispatch=False):
+        imputer.fit(X, sequence_ids=ids)
+    return imputer, on_device
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_crbm_imputer_fills_on_the_input_device_as_on_numpy(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids, X_missing = _imputer_data(dtype_name)
+    X_xp = _to(xp, device, X_missing)
+    missing = np.isnan(X_missing)
+    with sklearn.config_context(array_api_dispatch=False):
+        model = ConditionalRBM(6, order=2, n_iter=5, random_state=0)
+        model.fit(X, sequence_ids=ids)
+    # mean field alone (no Gibbs sampling, one chain): deterministic
+    imputer, on_device = _moved_imputers(
+        xp, device, X, ids, model, n_gibbs=0, n_particles=1, offset_shrinkage=None
+    )
+    _same_place(on_device.mean_, X_xp)
+    filled = on_device.transform(X_xp)
+    _same_place(filled, X_xp)
+    rtol = 1e-4 if dtype_name == "float32" else 1e-10
+    with sklearn.config_context(array_api_dispatch=False):
+        expected = imputer.transform(X_missing)
+    np.testing.assert_allclose(_numpy(filled), expected, rtol=rtol, atol=rtol)
+    # the defaults (particles, resampling, offsets): observed values untouched,
+    # the same fills for the same random_state
+    imputer, on_device = _moved_imputers(xp, device, X, ids, model)
+    filled = on_device.transform(X_xp)
+    _same_place(filled, X_xp)
+    filled = _numpy(filled)
+    assert not np.isnan(filled).any()
+    np.testing.assert_array_equal(filled[~missing], X_missing[~missing])
+    np.testing.assert_array_equal(_numpy(on_device.transform(X_xp)), filled)
+    draws = on_device.sample(X_xp, 2)
+    _same_place(draws, X_xp)
+    assert draws.shape == (2, *X_missing.shape)
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_crbm_imputer_draws_agree_with_numpy_in_distribution(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids, X_missing = _imputer_data(dtype_name)
+    missing = np.isnan(X_missing)
+    with sklearn.config_context(array_api_dispatch=False):
+        model = ConditionalRBM(6, order=2, n_iter=5, random_state=0)
+        model.fit(X, sequence_ids=ids)
+        # strong weights, so that Gibbs sampling makes the fills vary
+        model.components_ = 30 * model.components_
+    params = dict(n_gibbs=5, n_particles=4, offset_shrinkage=10.0)
+    imputer, on_device = _moved_imputers(xp, device, X, ids, model, **params)
+    n = 40
+    with sklearn.config_context(array_api_dispatch=False):
+        expected = imputer.sample(X_missing, n)[:, missing]
+    got = _numpy(on_device.sample(_to(xp, device, X_missing), n))[:, missing]
+    spread = expected.std(axis=0)
+    assert spread.mean() > 0.01  # the draws do vary
+    standard_error = np.sqrt((spread**2 + got.var(axis=0)) / n)
+    assert np.all(
+        np.abs(got.mean(axis=0) - expected.mean(axis=0)) < 5 * standard_error + 1e-4
+    )
+    assert 0.7 < got.std(axis=0).mean() / spread.mean() < 1.4
+
+
+@pytest.mark.parametrize(
+    "namespace, device_name, dtype_name",
+    [c for c in DEVICE_COMBINATIONS if c[0] == "array_api_strict"],
+)
+def test_particle_resampling_is_numpy_s_given_the_same_draws(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    with sklearn.config_context(array_api_dispatch=False):
+        model = ConditionalRBM(6, order=2, n_iter=5, random_state=0)
+        model.fit(X, sequence_ids=ids)
+        model.autoregressive_ = 30 * model.autoregressive_  # pasts matter
+    moved = move_estimator_to(model, xp, device)
+    n_particles, n_sequences = 4, 3
+    # 2 groups of 4 particles per sequence, each with its own past
+    past = np.random.default_rng(1).normal(size=(8, n_sequences, 3, X.shape[1]))
+    past = past.astype(X.dtype)
+    frames, observed = X[:n_sequences], X[:n_sequences] > 0
+    results = []
+    for estimator, to in ((model, np.asarray), (moved, partial(_to, xp, device))):
+        layers = estimator._layer_parameters()
+        history = History.from_frames(layers, to(past))
+        sequences = np.arange(n_sequences) if to is np.asarray else slice(None)
+        chains = _ancestors(
+            history,
+            sequences,
+            to(frames),
+            to(observed),
+            n_particles,
+            ArrayRandom(7, array_ops(to(frames)))
+            if to is not np.asarray
+            else np.random.default_rng(7),
+        )
+        history.reorder(chains, sequences)
+        results.append((_numpy(chains), _numpy(history.windows[0])))
+    (chains, windows), (chains_xp, windows_xp) = results
+    assert (chains != np.arange(8)[:, None]).any()  # some pasts were copied
+    np.testing.assert_array_equal(chains_xp, chains)
+    np.testing.assert_array_equal(windows_xp, windows)
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_crbm_imputer_trains_a_stack_on_the_input_device(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids, X_missing = _imputer_data(dtype_name)
+    missing = np.isnan(X_missing)
+    stack = StackedCRBM((8, 6), order=2, n_iter=2, random_state=0)
+    imputer = CRBMImputer(stack, n_gibbs=3, n_particles=3, random_state=0)
+    imputer.fit(_to(xp, device, X), sequence_ids=ids)
+    _same_place(imputer.estimator_.layers_[0].components_, _to(xp, device, X))
+    filled = imputer.transform(_to(xp, device, X_missing))
+    _same_place(filled, _to(xp, device, X_missing))
+    filled = _numpy(filled)
+    assert not np.isnan(filled).any()
+    np.testing.assert_array_equal(filled[~missing], X_missing[~missing])
+    with pytest.raises(TypeError, match="move_estimator_to"):
+        imputer.transform(X_missing)
 
 
 @pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)

@@ -9,11 +9,13 @@ from sklearn.utils.validation import FLOAT_DTYPES, validate_data
 from ..utils._sequences import check_sequence_ids
 
 
-def check_imputer_input(imputer, X, *, reset):
+def check_imputer_input(imputer, X, *, reset, array_api=False):
     """Validate ``X`` the way :mod:`sklearn.impute` does.
 
     NaN is allowed when it is the missing-value marker; the returned array is
     a float copy (never the caller's array), so it can be filled in place.
+    ``array_api=True``: ``X`` may be any array API namespace's array (with
+    ``sklearn.set_config(array_api_dispatch=True)``), and stays in it.
 
     Returns
     -------
@@ -22,7 +24,7 @@ def check_imputer_input(imputer, X, *, reset):
         True where ``X`` holds ``missing_values``.
     """
     xp = get_namespace(X)[0]
-    if not _is_numpy_namespace(xp):
+    if not (array_api or _is_numpy_namespace(xp)):
         raise TypeError(
             f"{type(imputer).__name__} fills numpy arrays only; got {xp.__name__} "
             "input under sklearn.set_config(array_api_dispatch=True). Pass X as a "
@@ -34,13 +36,17 @@ def check_imputer_input(imputer, X, *, reset):
     X = validate_data(
         imputer,
         X,
-        dtype=FLOAT_DTYPES,
+        dtype=FLOAT_DTYPES if _is_numpy_namespace(xp) else [xp.float64, xp.float32],
         ensure_all_finite=ensure_all_finite,
         copy=True,
         force_writeable=True,
         reset=reset,
     )
-    return X, _get_mask(X, imputer.missing_values)
+    if _is_numpy_namespace(xp):
+        return X, _get_mask(X, imputer.missing_values)
+    if is_scalar_nan(imputer.missing_values):
+        return X, xp.isnan(X)
+    return X, X == imputer.missing_values
 
 
 def complete_runs(mask, sequence_ids):

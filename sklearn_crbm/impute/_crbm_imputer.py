@@ -11,6 +11,7 @@ from sklearn.base import (
     clone,
 )
 from sklearn.frozen import FrozenEstimator
+from sklearn.utils._array_api import _convert_to_numpy, get_namespace_and_device
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import HasMethods, Interval, MissingValues
 from sklearn.utils.validation import check_is_fitted
@@ -18,8 +19,9 @@ from sklearn.utils.validation import check_is_fitted
 from .._base import check_count
 from .._crbm import ConditionalRBM
 from .._online import WHOLE_STACK, Observed, run_online
+from ..utils._array_api import array_ops, array_random, copy_array
 from ..utils._fitting import unfitted_on_error
-from ..utils._parallel import map_sequence_blocks
+from ..utils._parallel import BLOCK_SEQUENCES, map_sequence_blocks
 from ..utils._persistence import VersionedPickleMixin
 from ..utils._random import rng_from
 from ..utils._sequences import Sequences, check_sequence_ids
@@ -180,6 +182,15 @@ class CRBMImputer(
     frame (without ``sample``'s small jitter).  Frames without missing
     channels are copied and cost nothing.
 
+    *Array API.*  With ``sklearn.set_config(array_api_dispatch=True)``,
+    :meth:`fit`, :meth:`transform` and :meth:`sample` take PyTorch (or
+    array-api-strict, CuPy) arrays and work on their device; the output is in
+    the input's namespace, on its device, in its dtype.  A frozen model must
+    be there already (``sklearn.utils._array_api.move_estimator_to``).  There
+    every sequence advances at every step, drawing frames with nothing
+    missing too (they come back unchanged), so the random numbers, and the
+    fills, differ from numpy's but agree with them in distribution.
+
     All sequences advance frame by frame together, and so do the
     ``n_draws * n_particles`` chains: the cost is about ``2 * n_gibbs``
     matrix products of ``n_draws * n_particles`` rows per frame of the
@@ -286,17 +297,18 @@ class CRBMImputer(
             The fitted imputer.
         """
         with unfitted_on_error(self):
-            X, mask = check_imputer_input(self, X, reset=True)
-            rows, run_ids = complete_runs(mask, sequence_ids)
-            X = X[rows]
+            X, mask = check_imputer_input(self, X, reset=True, array_api=True)
+            ops = array_ops(X)
+            rows, run_ids = complete_runs(_to_numpy(mask), sequence_ids)
+            X = ops.take(X, rows, axis=0)
             estimator = self.estimator
             if estimator is None:
                 estimator = ConditionalRBM()
             if isinstance(estimator, FrozenEstimator):
-                self.estimator_ = _check_frozen(estimator.estimator, X.shape[1])
+                self.estimator_ = _check_frozen(estimator.estimator, X)
             else:
                 self.estimator_ = self._train(clone(estimator), X, run_ids)
-            self.mean_ = X.mean(axis=0)
+            self.mean_ = ops.mean(X, axis=0)
         return self
 
     def _train(self, estimator, X, sequence_ids):
@@ -383,18 +395,19 @@ class CRBMImputer(
 
     def _impute(self, X, sequence_ids, n_draws, random_state, average):
         check_is_fitted(self)
-        X, mask = check_imputer_input(self, X, reset=False)
+        X, mask = check_imputer_input(self, X, reset=False, array_api=True)
+        _check_same_place(self.estimator_, X, "CRBMImputer was fitted with")
+        ops = array_ops(X)
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
-        if not mask.any():
-            return X if average else np.broadcast_to(X, (n_draws, *X.shape)).copy()
+        if not bool(ops.any(mask)):
+            return (
+                X if average else copy_array(ops.broadcast_to(X, (n_draws, *X.shape)))
+            )
         rng = rng_from(random_state)
         draws = self._fill_blocks(X, mask, sequences, n_draws, rng)
         if average:
-            X[mask] = draws.mean(axis=0)[mask]
-            return X
-        out = np.broadcast_to(X, draws.shape).copy()
-        out[:, mask] = draws[:, mask]
-        return out
+            draws = ops.mean(draws, axis=0)
+        return ops.where(mask, ops.astype(draws, X.dtype), X)
 
     def _fill_blocks(self, X, mask, sequences, n_draws, rng):
         """:meth:`_fill` on blocks of whole sequences, in parallel with ``n_jobs``.
@@ -405,20 +418,26 @@ class CRBMImputer(
         """
 
         def fill_block(block, block_rng):
-            lo, hi = sequences.starts[block[0]], sequences.stops[block[-1]]
+            lo, hi = int(sequences.starts[block[0]]), int(sequences.stops[block[-1]])
             block_sequences = Sequences(
                 starts=sequences.starts[block] - lo,
                 lengths=sequences.lengths[block],
                 ids=sequences.ids[block],
             )
             return self._fill(
-                X[lo:hi], mask[lo:hi], block_sequences, n_draws, block_rng
+                X[lo:hi, ...], mask[lo:hi, ...], block_sequences, n_draws, block_rng
             )
 
+        ops = array_ops(X)
         blocks = map_sequence_blocks(
-            fill_block, sequences.n_sequences, rng, self.n_jobs
+            fill_block,
+            sequences.n_sequences,
+            rng,
+            self.n_jobs,
+            # an accelerator fills every sequence in one pass
+            block_size=BLOCK_SEQUENCES if ops is np else sequences.n_sequences,
         )
-        return np.concatenate(blocks, axis=1)
+        return ops.concatenate(blocks, axis=1)
 
     def _fill(self, X, mask, sequences, n_draws, rng):
         """``n_draws`` on-line fills, all sequences and draws advancing together.
@@ -429,18 +448,17 @@ class CRBMImputer(
         ``(n_draws, n_frames, n_features)`` in the model's dtype.
         """
         layers = self.estimator_._layer_parameters()
-        dtype = layers[0].dtype
-        X = X.astype(dtype)
-        out = np.broadcast_to(X, (n_draws, *X.shape)).copy()
+        dtype, ops = layers[0].dtype, layers[0].ops
+        X = ops.astype(X, dtype)
         # a sequence's first frame starts its missing channels at the mean
         observed = Observed(
-            X=np.where(mask, self.mean_.astype(dtype), X),
+            X=ops.where(mask, ops.astype(self.mean_, dtype), X),
             missing=mask,
             sequences=sequences,
         )
         run = run_online(
             layers,
-            rng,
+            array_random(rng, X),
             observed=observed,
             n_chains=n_draws * self.n_particles,
             n_particles=self.n_particles,
@@ -448,6 +466,9 @@ class CRBMImputer(
             scheme=WHOLE_STACK,
             offset_shrinkage=self.offset_shrinkage,
         )
+        if ops is not np:
+            return self._gather_fills(run, sequences, n_draws, X.shape)
+        out = np.broadcast_to(X, (n_draws, *X.shape)).copy()
         for step, active, drawn, frames in run:
             if not len(drawn):
                 continue
@@ -455,30 +476,65 @@ class CRBMImputer(
             out[:, sequences.starts[active[drawn]] + step] = fills.mean(axis=1)
         return out
 
+    def _gather_fills(self, run, sequences, n_draws, shape):
+        """:meth:`_fill`'s result from :func:`run_online` off numpy.
+
+        There every step holds every sequence's frame (see
+        :func:`~sklearn_crbm._online.run_online`): the steps are stacked and
+        the frames of the data gathered from them in one go, on the device.
+        """
+        n_sequences = len(sequences.starts)
+        fills = []
+        for _, _, _, frames in run:
+            ops = array_ops(frames)
+            frames = ops.reshape(frames, (n_draws, self.n_particles, n_sequences, -1))
+            fills.append(ops.mean(frames, axis=1))
+        # row ``starts[s] + t`` of the data is step t of sequence s
+        index = np.zeros(shape[0], dtype=np.int64)
+        for s, (start, length) in enumerate(
+            zip(sequences.starts, sequences.lengths, strict=True)
+        ):
+            index[start : start + length] = np.arange(length) * n_sequences + s
+        steps = ops.reshape(ops.xp.stack(fills, axis=1), (n_draws, -1, shape[1]))
+        return ops.take(steps, index, axis=1)
+
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
         tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
         return tags
 
 
-def _check_frozen(model, n_features):
+def _to_numpy(array):
+    return _convert_to_numpy(array, get_namespace_and_device(array)[0])
+
+
+def _check_same_place(model, X, what):
+    """Refuse ``X`` in another namespace or on another device than ``model``."""
+    if array_ops(model._packed_parameters) is not array_ops(X):
+        model_xp, _, model_device = get_namespace_and_device(model._packed_parameters)
+        xp, _, device = get_namespace_and_device(X)
+        raise TypeError(
+            f"{what} {model_xp.__name__} arrays on {model_device!r}, but X is "
+            f"{xp.__name__} on {device!r}. Pass X in the model's namespace and on "
+            "its device, or move the model first with "
+            "sklearn.utils._array_api.move_estimator_to(model, xp, device) (the "
+            "model, or the fitted imputer)."
+        )
+
+
+def _check_frozen(model, X):
     """The fitted model inside a ``FrozenEstimator``, checked against the data."""
     check_is_fitted(
         model,
         msg="CRBMImputer got FrozenEstimator(%(name)s) with an unfitted model: "
         "fit the model first, or pass it without FrozenEstimator to train it.",
     )
+    n_features = X.shape[1]
     if model.n_features_in_ != n_features:
         raise ValueError(
             f"The frozen {type(model).__name__} was fitted on "
             f"{model.n_features_in_} features but X has {n_features}: fit the "
             "imputer on data with the model's features (same preprocessing)."
         )
-    flat = model._packed_parameters
-    if not isinstance(flat, np.ndarray):
-        raise TypeError(
-            f"The frozen {type(model).__name__} holds {type(flat).__module__} "
-            "arrays; CRBMImputer fills with numpy only. Move the model first: "
-            "sklearn.utils._array_api.move_estimator_to(model, numpy, 'cpu')."
-        )
+    _check_same_place(model, X, f"The frozen {type(model).__name__} holds")
     return model

@@ -147,9 +147,7 @@ class ArrayOps:
 
     # indexing
     def take(self, x, indices, axis=0, out=None, mode=None):
-        if isinstance(indices, np.ndarray) or not hasattr(
-            indices, "__array_namespace__"
-        ):
+        if not array_api_compat.is_array_api_obj(indices) or is_numpy(indices):
             indices = self.asarray(np.asarray(indices, dtype=np.int64))
         return self._into(out, self.xp.take(x, indices, axis=axis))
 
@@ -213,6 +211,9 @@ class ArrayOps:
     # reductions
     def sum(self, x, axis=None, dtype=None):
         return self.xp.sum(x, axis=axis, dtype=dtype)
+
+    def cumsum(self, x, axis=None):
+        return self.xp.cumulative_sum(x, axis=axis)
 
     def mean(self, x, axis=None):
         return self.xp.mean(x, axis=axis)
