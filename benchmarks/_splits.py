@@ -82,9 +82,19 @@ _TRAINING_PARAMETERS = (
 ).split()
 
 
+# Training parameters added later, with the value the fits cached before had:
+# in the key only when they differ from it.
+_LATER_PARAMETERS = {"init": "random"}
+
+
 def cached_model(cache_dir, model, X, sequence_ids):
     """``(fitted model, training seconds)``, from ``cache_dir`` when it is there."""
     params = {k: getattr(model, k) for k in _TRAINING_PARAMETERS if hasattr(model, k)}
+    params.update(
+        (k, getattr(model, k))
+        for k, before in _LATER_PARAMETERS.items()
+        if getattr(model, k, before) != before
+    )
     digest = hashlib.sha1(repr(sorted(params.items())).encode())
     digest.update(np.ascontiguousarray(X).tobytes())
     digest.update(np.ascontiguousarray(sequence_ids).tobytes())

@@ -13,9 +13,12 @@ Protocol (the paper's §4.4, as ``paper_fillin.py``, with a second split):
 - CRBM models (``--models``), one per training seed: ``default`` is
   ``CRBMImputer(ConditionalRBM(200, order=3, n_iter=1000))`` with every
   other parameter of both at its default, ``paper`` the same with
-  ``ConditionalRBM.paper_schedule(n_iter=1000)``; ``transform`` is called
-  once, as a user would.  Each model also fills with the paper's on-line
-  procedure (``--fillins paper``: one chain, no offset correction,
+  ``ConditionalRBM.paper_schedule(n_iter=1000)``, ``ar-init`` the defaults
+  with ``init="autoregressive"`` and ``ar-init-learned`` that with
+  ``visible_variance="learned"`` and ``cd_steps=5`` (both with
+  ``--ar-history-noise`` if given); ``transform`` is called once, as a
+  user would.  Each model also fills with the paper's on-line procedure
+  (``--fillins paper``: one chain, no offset correction,
   ``CRBMImputer(n_particles=1, offset_shrinkage=None)``), the defaults
   before the offset correction;
 - error: the paper's (per-frame mean squared error over the erased
@@ -71,14 +74,21 @@ def baselines():
     }
 
 
-def crbm_model(name, seed, n_iter):
+def crbm_model(name, seed, n_iter, ar_history_noise=None):
     """The ConditionalRBM of model ``name`` (see the module docstring)."""
     if name == "paper":
         return ConditionalRBM.paper_schedule(n_iter=n_iter, random_state=seed)
-    return ConditionalRBM(200, order=3, n_iter=n_iter, random_state=seed)
+    model = ConditionalRBM(200, order=3, n_iter=n_iter, random_state=seed)
+    if name.startswith("ar-init"):
+        model.set_params(init="autoregressive")
+        if ar_history_noise is not None:
+            model.set_params(history_noise=ar_history_noise)
+    if name == "ar-init-learned":
+        model.set_params(visible_variance="learned", cd_steps=5)
+    return model
 
 
-def fitted_imputer(cache_dir, split, model, seed, n_iter):
+def fitted_imputer(cache_dir, split, model, seed, n_iter, ar_history_noise=None):
     """``CRBMImputer(model).fit(X_train)``, with the model's training cached.
 
     ``fit`` would train a clone of the model; the cached fitted clone goes in
@@ -87,7 +97,10 @@ def fitted_imputer(cache_dir, split, model, seed, n_iter):
     """
     X = split.X_train.astype(np.float32)
     fitted, seconds = cached_model(
-        cache_dir, crbm_model(model, seed, n_iter), X, split.train_ids
+        cache_dir,
+        crbm_model(model, seed, n_iter, ar_history_noise),
+        X,
+        split.train_ids,
     )
     imputer = CRBMImputer(FrozenEstimator(fitted), random_state=seed)
     return imputer.fit(X, sequence_ids=split.train_ids), seconds
@@ -110,12 +123,13 @@ def main(argv=None):
         "--models",
         nargs="+",
         default=["default", "paper"],
-        choices=["default", "paper"],
+        choices=["default", "paper", "ar-init", "ar-init-learned"],
     )
     parser.add_argument(
         "--fillins", nargs="+", default=list(FILLINS), choices=list(FILLINS)
     )
     parser.add_argument("--n-iter", type=int, default=1000)
+    parser.add_argument("--ar-history-noise", type=float, default=None)
     parser.add_argument(
         "--cache-dir", default=str(Path(tempfile.gettempdir()) / "sklearn_crbm_issue15")
     )
@@ -137,7 +151,12 @@ def main(argv=None):
         for model in args.models:
             for seed in args.seeds:
                 imputer, seconds = fitted_imputer(
-                    args.cache_dir, split, model, seed, args.n_iter
+                    args.cache_dir,
+                    split,
+                    model,
+                    seed,
+                    args.n_iter,
+                    args.ar_history_noise,
                 )
                 for fillin in args.fillins:
                     row = model if fillin == "default" else f"{model}, paper's fill-in"

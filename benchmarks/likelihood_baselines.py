@@ -7,10 +7,20 @@ enumeration of the hidden units when that is cheaper, annealed importance
 sampling otherwise).
 
 - ``learned``: ConditionalRBM(200, order=3, visible_variance="learned",
-  cd_steps=5), one per training seed, trained on the split's training
-  trials but one walk and one jog kept for validation; the number of epochs
-  (a checkpoint among ``--checkpoints``) is the one with the best
-  validation log-likelihood, so the test trials choose nothing;
+  cd_steps=5, init=--init, history_noise=...), one per training seed,
+  trained on the split's training trials but one walk and one jog kept for
+  validation; the number of epochs (a checkpoint among ``--checkpoints``)
+  and the history noise (among ``--history-noise``) are those with the
+  best validation log-likelihood, so the test trials choose nothing;
+- ``residual RBM`` (``--rows residual``, a diagnostic): the ridge AR(3) of
+  the training trials, then an RBM (200 hidden units, learned variances,
+  CD-5) trained on its residuals divided by their per-channel standard
+  deviations ``s``, epochs chosen on validation as above.  It is exactly a
+  CRBM of order 3 (variances ``(s sigma)^2``, autoregressive weights
+  those of the AR, past-to-hidden weights ``-W diag(1 / (s sigma)) A``
+  and hidden biases ``b - W (c / (s sigma))``, so that the hidden units
+  see the residual), written into a ``ConditionalRBM`` and scored as the
+  others: what a CRBM whose hidden units model the AR's residuals gets;
 - ``default``: the defaults (unit variances) of ``fillin_baselines.py``,
   1000 epochs, for ``--default-seeds``;
 - baselines: the ridge AR(3) of ``AutoregressiveImputer`` (alpha 1) with
@@ -23,6 +33,9 @@ Prints the table and writes JSON to
 
     python benchmarks/likelihood_baselines.py
     python benchmarks/likelihood_baselines.py --seeds 0 --splits paper
+    python benchmarks/likelihood_baselines.py --init autoregressive \
+        --history-noise 0 0.2 0.4 0.8 --checkpoints 1 2 3 5 10 25 50 100 \
+        --default-seeds --output benchmarks/results/likelihood_ar_init.json
 """
 
 import os
@@ -46,6 +59,7 @@ from scipy.stats import multivariate_normal  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
 from sklearn_crbm.impute import AutoregressiveImputer  # noqa: E402
+from sklearn_crbm.utils._autoregression import ridge_autoregression  # noqa: E402
 from sklearn_crbm.utils._sequences import check_sequence_ids, frame_history  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
@@ -87,30 +101,89 @@ def validation_split(split):
     return (split.X_train[~held], ids[~held]), (split.X_train[held], ids[held])
 
 
-def learned_model(seed):
+def learned_model(seed, init="random", history_noise=0.8):
     return ConditionalRBM(
-        200, order=ORDER, visible_variance="learned", cd_steps=5, random_state=seed
+        200,
+        order=ORDER,
+        visible_variance="learned",
+        cd_steps=5,
+        init=init,
+        history_noise=history_noise,
+        random_state=seed,
     )
 
 
-def chosen_by_validation(split, seed, checkpoints):
-    """Train with checkpoints; the one with the best validation log-likelihood."""
+def chosen_by_validation(split, seed, checkpoints, init="random", noises=(0.8,)):
+    """Train with checkpoints; the one with the best validation log-likelihood.
+
+    Returns the model, its ``(history noise, epochs)`` and every validation
+    score, by history noise and epoch.
+    """
     (X, ids), (X_val, val_ids) = validation_split(split)
     X, X_val = X.astype(np.float32), X_val.astype(np.float32)
-    model = learned_model(seed)
     frames = check_sequence_ids(val_ids, len(X_val)).valid_frames(ORDER)
     best = (-np.inf, None, None)
     scores = {}
+    for noise in noises:
+        model = learned_model(seed, init, noise)
+        for epoch in range(1, max(checkpoints) + 1):
+            model.partial_fit(X, sequence_ids=ids)
+            if epoch in checkpoints:
+                value = float(
+                    model.score_samples(X_val, sequence_ids=val_ids)[frames].mean()
+                )
+                scores.setdefault(noise, {})[epoch] = value
+                if value > best[0]:
+                    best = (value, (noise, epoch), copy.deepcopy(model))
+    return best[2], best[1], scores
+
+
+def residual_rbm(split, seed, checkpoints):
+    """The AR(3), then an RBM on its whitened residuals, as one ConditionalRBM.
+
+    Returns the CRBM whose RBM epochs (among ``checkpoints``) score best on
+    the validation trials, its epochs and every validation score.
+    """
+    (X, ids), (X_val, val_ids) = validation_split(split)
+    X, X_val = X.astype(np.float32), X_val.astype(np.float32)
+    ar = ridge_autoregression(
+        X.astype(np.float64),
+        check_sequence_ids(ids, len(X)).valid_frames(ORDER),
+        ORDER,
+        1.0,
+    )
+    s = np.sqrt(np.mean(np.square(ar.residual), axis=0))
+    rbm = ConditionalRBM(
+        200, order=0, visible_variance="learned", cd_steps=5, random_state=seed
+    )
+    crbm = ConditionalRBM(200, order=ORDER, visible_variance="learned").partial_fit(
+        X, sequence_ids=ids
+    )
+    frames = check_sequence_ids(val_ids, len(X_val)).valid_frames(ORDER)
+    best, scores = (-np.inf, None, None), {}
     for epoch in range(1, max(checkpoints) + 1):
-        model.partial_fit(X, sequence_ids=ids)
+        rbm.partial_fit((ar.residual / s).astype(np.float32))
         if epoch in checkpoints:
+            _write_residual_crbm(crbm, ar, s, rbm)
             value = float(
-                model.score_samples(X_val, sequence_ids=val_ids)[frames].mean()
+                crbm.score_samples(X_val, sequence_ids=val_ids)[frames].mean()
             )
             scores[epoch] = value
             if value > best[0]:
-                best = (value, epoch, copy.deepcopy(model))
+                best = (value, epoch, copy.deepcopy(crbm))
     return best[2], best[1], scores
+
+
+def _write_residual_crbm(crbm, ar, s, rbm):
+    """Set ``crbm`` to the AR plus ``rbm`` on the residuals divided by ``s``."""
+    scale = s * np.sqrt(rbm.visible_variance_.astype(np.float64))
+    W = rbm.components_.astype(np.float64)
+    crbm.visible_variance_ = scale**2
+    crbm.intercept_visible_ = ar.intercept + s * rbm.intercept_visible_
+    crbm.autoregressive_ = ar.coef
+    crbm.components_ = W
+    crbm.intercept_hidden_ = rbm.intercept_hidden_ - W @ (ar.intercept / scale)
+    crbm.past_to_hidden_ = -np.einsum("jd,qdk->qjk", W / scale, ar.coef)
 
 
 def main(argv=None):
@@ -121,6 +194,25 @@ def main(argv=None):
     parser.add_argument("--splits", nargs="+", default=list(SPLITS), choices=SPLITS)
     parser.add_argument(
         "--checkpoints", type=int, nargs="+", default=[10, 25, 50, 100, 200]
+    )
+    parser.add_argument(
+        "--init", choices=["random", "autoregressive"], default="random"
+    )
+    parser.add_argument("--history-noise", type=float, nargs="+", default=[0.8])
+    parser.add_argument(
+        "--rows",
+        nargs="+",
+        default=["learned"],
+        choices=["learned", "residual"],
+        help="CRBM rows for --seeds: learned variances, residual RBM",
+    )
+    parser.add_argument(
+        "--test-ais",
+        type=int,
+        nargs=2,
+        default=None,
+        metavar=("STEPS", "CHAINS"),
+        help="annealing of the test scores (default: the models' 50 x 2)",
     )
     parser.add_argument(
         "--cache-dir", default=str(Path(tempfile.gettempdir()) / "sklearn_crbm_issue15")
@@ -143,16 +235,34 @@ def main(argv=None):
         X_test = split.X_test.astype(np.float32)
         rows = {}
         for seed in args.seeds:
-            model, epochs, validation = chosen_by_validation(
-                split, seed, set(args.checkpoints)
-            )
-            test = model.score_samples(X_test, sequence_ids=split.test_ids)
-            rows.setdefault("learned", {})[seed] = dict(
-                log_likelihood=float(test[frames].mean()),
-                epochs=epochs,
-                validation=validation,
-            )
-            print(f"  {split_name} learned seed {seed}: {epochs} epochs", flush=True)
+            if "learned" in args.rows:
+                model, (noise, epochs), validation = chosen_by_validation(
+                    split, seed, set(args.checkpoints), args.init, args.history_noise
+                )
+                rows.setdefault(f"learned, init={args.init}", {})[seed] = dict(
+                    **test_scores(model, X_test, split.test_ids, frames, args.test_ais),
+                    epochs=epochs,
+                    history_noise=noise,
+                    validation=validation,
+                )
+                print(
+                    f"  {split_name} learned seed {seed}: history noise {noise}, "
+                    f"{epochs} epochs",
+                    flush=True,
+                )
+            if "residual" in args.rows:
+                model, epochs, validation = residual_rbm(
+                    split, seed, set(args.checkpoints)
+                )
+                rows.setdefault("residual RBM", {})[seed] = dict(
+                    **test_scores(model, X_test, split.test_ids, frames, args.test_ais),
+                    epochs=epochs,
+                    history_noise=0.0,
+                    validation=validation,
+                )
+                print(
+                    f"  {split_name} residual seed {seed}: {epochs} epochs", flush=True
+                )
         for seed in args.default_seeds:
             model, _ = cached_model(
                 args.cache_dir,
@@ -175,19 +285,33 @@ def main(argv=None):
     return results
 
 
+def test_scores(model, X_test, test_ids, frames, ais):
+    """Mean test log-likelihood, forward and reverse (RAISE) annealing."""
+    if ais is not None:
+        model.set_params(ais_steps=ais[0], ais_chains=ais[1])
+    result = model.estimate_log_likelihood(X_test, sequence_ids=test_ids)
+    return dict(
+        log_likelihood=float(result.log_likelihood[frames].mean()),
+        reverse=float(result.lower[frames].mean()),
+    )
+
+
 def report(split_name, trials, n_frames, base, rows):
     print(
         f"\nSplit '{split_name}' (walk {trials[0]}, jog {trials[1]} held out, "
         f"{n_frames} frames): log p(x_t | past), nats per frame"
     )
     for name, value in base.items():
-        print(f"| {name:44s} | {value:>9.2f} |")
+        print(f"| {name:64s} | {value:>9.2f} |")
     for model, per_seed in rows.items():
         for seed, row in per_seed.items():
             label = f"CRBM {model}, seed {seed}" + (
-                f" ({row['epochs']} epochs)" if "epochs" in row else ""
+                f" (noise {row['history_noise']:g}, {row['epochs']} epochs)"
+                if "epochs" in row
+                else ""
             )
-            print(f"| {label:44s} | {row['log_likelihood']:>9.2f} |")
+            reverse = f" (reverse {row['reverse']:.2f})" if "reverse" in row else ""
+            print(f"| {label:64s} | {row['log_likelihood']:>9.2f} |{reverse}")
 
 
 if __name__ == "__main__":

@@ -94,7 +94,7 @@ def _parser():
     demo.add_argument(
         "--n-particles",
         type=int,
-        default=10,
+        default=20,
         help="weighted particles per fill-in chain (1: the original scheme)",
     )
     demo.add_argument(

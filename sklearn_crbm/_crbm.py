@@ -7,8 +7,13 @@ from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import _fit_context
+from sklearn.externals import array_api_compat
 from sklearn.utils import Bunch, check_random_state
-from sklearn.utils._array_api import get_namespace_and_device, move_to
+from sklearn.utils._array_api import (
+    _convert_to_numpy,
+    get_namespace_and_device,
+    move_to,
+)
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import validate_data
 
@@ -22,6 +27,7 @@ from ._crbm_math import (
     cd_gradients,
 )
 from .utils._array_api import array_ops, array_random
+from .utils._autoregression import ridge_autoregression
 from .utils._fitting import unfitted_on_error
 from .utils._random import rng_from
 from .utils._sequences import (
@@ -32,6 +38,9 @@ from .utils._sequences import (
     validation_split,
 )
 from .utils._threads import batch_rows, frame_rows, limit_blas_threads
+
+# Ridge penalty of init="autoregressive": AutoregressiveImputer's default.
+_AUTOREGRESSIVE_ALPHA = 1.0
 
 
 class TrainingDivergedError(FloatingPointError):
@@ -77,6 +86,19 @@ class ConditionalRBM(BaseCRBM):
         worse than unit variances with ``history_noise``
         (``benchmarks/fillin_baselines.py``).  Gaussian visibles only;
         variances are kept at or above 1e-4 (standardised data).
+    init : {"random", "autoregressive"}, default="random"
+        How the parameters start.  ``"random"``: the paper's (small random
+        weights, see :meth:`CRBMParameters.initialize
+        <sklearn_crbm._crbm_math.CRBMParameters.initialize>`).
+        ``"autoregressive"``: the same, but the autoregressive weights and
+        the visible biases are those of a ridge regression (penalty
+        ``alpha=1``, as :class:`~sklearn_crbm.impute.AutoregressiveImputer`)
+        of every trainable frame on its ``order`` past frames, and with
+        ``visible_variance="learned"`` the variances are the per-channel
+        mean squared residuals of that regression.  Were ``W`` and the
+        past-to-hidden weights zero, the model would then be exactly that
+        linear-Gaussian AR model; training starts there and refines it.
+        Gaussian visibles only.
     learning_rate : float, default=1e-3
         Step size for every parameter group.
     momentum : float, default=0.9
@@ -253,6 +275,7 @@ class ConditionalRBM(BaseCRBM):
         "validation_interval": [Interval(Integral, 1, None, closed="left")],
         "tol": [Interval(Real, 0, None, closed="left")],
         "visible_variance": [StrOptions({"unit", "learned"})],
+        "init": [StrOptions({"random", "autoregressive"})],
     }
 
     # Private state that a failed fit must forget with the fitted attributes:
@@ -274,6 +297,7 @@ class ConditionalRBM(BaseCRBM):
         hidden_order=None,
         visible_type="gaussian",
         visible_variance="unit",
+        init="random",
         learning_rate=1e-3,
         momentum=0.9,
         momentum_delay=5,
@@ -298,6 +322,7 @@ class ConditionalRBM(BaseCRBM):
         self.hidden_order = hidden_order
         self.visible_type = visible_type
         self.visible_variance = visible_variance
+        self.init = init
         self.learning_rate = learning_rate
         self.momentum = momentum
         self.momentum_delay = momentum_delay
@@ -396,6 +421,7 @@ class ConditionalRBM(BaseCRBM):
             if self.early_stopping:
                 self._train_with_early_stopping(X, sequences)
             else:
+                self._start_autoregressive(X, frames)
                 self._train(X, frames, self.n_iter)
             self.seed_windows_ = self._pick_seed_windows(X, sequences)
         return self
@@ -441,6 +467,7 @@ class ConditionalRBM(BaseCRBM):
             if first_call:
                 self.random_state_ = check_random_state(self.random_state)
                 self._initialize(X)
+                self._start_autoregressive(X, frames)
             self._train(X, frames, 1)
         self.seed_windows_ = self._merge_seed_windows(
             self._pick_seed_windows(X, sequences)
@@ -467,6 +494,11 @@ class ConditionalRBM(BaseCRBM):
             raise ValueError(
                 "visible_variance='learned' needs Gaussian visibles; binary "
                 "visibles have no variance to learn. Use visible_variance='unit'."
+            )
+        if self.visible_type == BINARY and self.init == "autoregressive":
+            raise ValueError(
+                "init='autoregressive' starts from a linear-Gaussian model and "
+                "needs Gaussian visibles. Use init='random' with binary visibles."
             )
         ops = array_ops(X)
         low, high = float(ops.min(X)), float(ops.max(X))
@@ -513,6 +545,28 @@ class ConditionalRBM(BaseCRBM):
         self.n_iter_ = 0
         self._parameters = params
         self._velocity = params.zeros_like(layout="F")
+
+    def _start_autoregressive(self, X, frames):
+        """With ``init="autoregressive"``: start from the ridge AR of ``frames``.
+
+        Sets the autoregressive weights, the visible biases and (learned
+        variances) the visible variances; the other groups keep their random
+        start.
+        """
+        if self.init != "autoregressive":
+            return
+        if not isinstance(X, np.ndarray):  # array API input: fitted with numpy
+            X = _convert_to_numpy(X, array_api_compat.array_namespace(X))
+        fit = ridge_autoregression(
+            X.astype(np.float64), frames, self.order, _AUTOREGRESSIVE_ALPHA
+        )
+        self.autoregressive_ = fit.coef.astype(X.dtype)
+        self.intercept_visible_ = fit.intercept.astype(X.dtype)
+        if self._parameters.learned_variance:
+            variance = np.mean(np.square(fit.residual), axis=0)
+            self.visible_variance_ = np.maximum(
+                variance, np.exp(MIN_LOG_VARIANCE)
+            ).astype(X.dtype)
 
     # Diverging weights overflow in the products before the epoch's check
     # raises TrainingDivergedError, which says what to do.
@@ -606,6 +660,7 @@ class ConditionalRBM(BaseCRBM):
             rows = np.flatnonzero(mask)
             parts.append((array_ops(X).take(X, rows, axis=0), part, frames))
         (X_train, _, train_frames), (X_valid, valid, valid_frames) = parts
+        self._start_autoregressive(X_train, train_frames)
         # the same random numbers at every check: changes are the model's
         seed = int(rng.integers(np.iinfo(np.int32).max))
         self.validation_scores_ = []

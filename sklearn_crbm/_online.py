@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._crbm_math import (
+    BINARY,
     dynamic_biases,
     gibbs_frames,
     hidden_probabilities,
@@ -212,19 +213,23 @@ class Offsets:
     noise``, with a prior worth ``shrinkage`` frames of zero residual:
     ``sum(r) / (n + shrinkage)`` over the ``n`` frames of the sequence in
     which the channel was observed so far (counted from the model's order
-    on: earlier frames have an edge-padded past).
+    on: earlier frames have an edge-padded past).  Binary visibles' fills
+    are probabilities, and stay in [0, 1].
 
     Parameters
     ----------
-    n_chains, n_sequences, n_features : int
-    dtype : dtype
+    n_chains, n_sequences : int
+    bottom : CRBMParameters
+        The bottom layer (its number of features and visible type).
     shrinkage : float
+    dtype : dtype
     """
 
-    def __init__(self, n_chains, n_sequences, n_features, dtype, shrinkage):
-        self.sums = np.zeros((n_chains, n_sequences, n_features), dtype)
-        self.counts = np.zeros((n_sequences, n_features), dtype)
+    def __init__(self, n_chains, n_sequences, bottom, shrinkage, *, dtype):
+        self.sums = np.zeros((n_chains, n_sequences, bottom.n_features), dtype)
+        self.counts = np.zeros((n_sequences, bottom.n_features), dtype)
         self.shrinkage = shrinkage
+        self.binary = bottom.visible_type == BINARY
 
     def update(self, layers, biases, sequences, frames, observed):
         """Add the residuals of ``frames`` (one per sequence) where ``observed``."""
@@ -235,11 +240,12 @@ class Offsets:
         self.sums[:, sequences] += np.where(observed, frames - prediction, 0)
         self.counts[sequences] += observed
 
-    def correction(self, sequences, missing):
-        """What to add to each chain's fill of ``sequences``: 0 where observed."""
+    def corrected(self, frames, sequences, missing):
+        """Every chain's ``frames`` of ``sequences``, corrected where ``missing``."""
         # a channel never observed has a zero sum; the floor spares 0 / 0
         denominator = np.maximum(self.counts[sequences] + self.shrinkage, 1)
-        return np.where(missing, self.sums[:, sequences] / denominator, 0)
+        frames = frames + np.where(missing, self.sums[:, sequences] / denominator, 0)
+        return np.clip(frames, 0, 1, out=frames) if self.binary else frames
 
     def reorder(self, chains, sequences):
         """The chains' offsets follow their pasts (:meth:`History.reorder`)."""
@@ -390,7 +396,9 @@ def run_online(
     n_steps = int(lengths.max(initial=0)) if n_steps is None else n_steps
     offsets = None
     if offset_shrinkage is not None:
-        offsets = Offsets(n_chains, len(starts), n_features, X.dtype, offset_shrinkage)
+        offsets = Offsets(
+            n_chains, len(starts), layers[0], offset_shrinkage, dtype=X.dtype
+        )
     for step in range(n_steps):
         sequences = np.flatnonzero(lengths > step)
         rows = starts[sequences] + step
@@ -436,8 +444,8 @@ def run_online(
                 start += start_jitter * rng.standard_normal(start.shape, start.dtype)
             current[:, drawn] = draw(start, [b[:, drawn] for b in biases], clamp)[0]
             if offsets is not None:
-                current[:, drawn] += offsets.correction(
-                    sequences[drawn], frame_missing[drawn]
+                current[:, drawn] = offsets.corrected(
+                    current[:, drawn], sequences[drawn], frame_missing[drawn]
                 )
         yield step, sequences, drawn, current[:, drawn]
         history.push([current], sequences, biases)

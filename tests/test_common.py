@@ -50,6 +50,9 @@ ROOT_DELTAS = (
 def _tested_estimators():
     """One small instance of every public estimator, some in several settings."""
     yield ConditionalRBM(n_components=8, n_iter=5, random_state=0)
+    yield ConditionalRBM(
+        n_components=8, n_iter=5, init="autoregressive", random_state=0
+    )
     yield StackedCRBM((8, 6), order=3, n_iter=5, random_state=0)
     yield CRBMImputer(
         ConditionalRBM(n_components=8, n_iter=5, random_state=0),

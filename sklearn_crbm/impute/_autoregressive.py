@@ -14,6 +14,7 @@ from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import Interval, MissingValues, StrOptions
 from sklearn.utils.validation import check_is_fitted
 
+from ..utils._autoregression import ridge_autoregression
 from ..utils._fitting import unfitted_on_error
 from ..utils._persistence import VersionedPickleMixin
 from ..utils._sequences import check_sequence_ids, frame_history
@@ -162,30 +163,16 @@ class AutoregressiveImputer(
                     f"their own sequence, but the longest complete sequence has "
                     f"{longest} {noun}. Pass longer sequences or lower order."
                 )
-            n_features = X.shape[1]
             self.mean_ = X.mean(axis=0)
             self.frame_covariance_ = self._regularised(
                 np.cov(X, rowvar=False, bias=True)
             )
-            target = X[frames]
-            history = frame_history(X, frames, self.order)
-            history_mean = history.mean(axis=0)
-            centred = history - history_mean
-            gram = centred.T @ centred
-            gram[np.diag_indices_from(gram)] += self.alpha
-            weights = (
-                linalg.solve(
-                    gram, centred.T @ (target - target.mean(axis=0)), assume_a="pos"
-                )
-                if self.order
-                else np.zeros((0, n_features))
+            fit = ridge_autoregression(X, frames, self.order, self.alpha)
+            self.intercept_ = fit.intercept
+            self.covariance_ = self._regularised(
+                fit.residual.T @ fit.residual / len(frames)
             )
-            self.intercept_ = target.mean(axis=0) - history_mean @ weights
-            residual = target - history @ weights - self.intercept_
-            self.covariance_ = self._regularised(residual.T @ residual / len(frames))
-            self.coef_ = np.ascontiguousarray(
-                weights.T.reshape(n_features, self.order, n_features).transpose(1, 0, 2)
-            )
+            self.coef_ = fit.coef
         return self
 
     def _regularised(self, covariance):

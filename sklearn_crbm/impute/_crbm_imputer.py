@@ -63,26 +63,30 @@ class CRBMImputer(
         Number of independent fills averaged by :meth:`transform`: one
         draw is one sample of the model's on-line fill, the average of many
         estimates its posterior mean, which has a lower squared error.
-    n_particles : int, default=10
+    n_particles : int, default=20
         Chains per draw.  With more than one, each draw is a particle
         filter: before every frame, the draw's particles are resampled in
         proportion to how well each one's past predicts the frame's observed
         channels, and the draw's fill of the frame is the mean of its
         particles' fills (see Notes).  ``1`` is the paper's single chain.
-        The default's ten chains cost about ten times one (still many times
-        real time) and, with the offset correction, beat every simple
-        baseline in 27 of 40 cells of ``benchmarks/fillin_baselines.py``
-        against 9 for one chain.
+        Mostly the mean of many chains lowers the squared error; with the
+        offset correction, on the 40 cells of
+        ``benchmarks/fillin_baselines.py`` (three random streams each),
+        1, 10, 20 and 40 chains beat every simple baseline in 9, 23-27,
+        26-29 and 27-29 cells.  Twenty cost about twenty times one chain
+        (still several times real time).
     offset_shrinkage : float or None, default=30.0
         Correct each fill for the model's systematic error on the sequence
-        at hand (see Notes).  ``None`` is the paper's procedure, without
-        correction (with ``n_particles=1``: the paper's fill-in exactly).  A number ``lam >= 0``: a missing entry of channel
-        ``j`` is shifted by ``sum(r) / (n + lam)``, where ``r`` are the
-        channel's one-step residuals (observed value minus the chain's
-        mean-field prediction from its past) over the ``n`` frames of the
-        sequence in which it was observed so far: the mean residual, shrunk
-        towards 0 as if ``lam`` frames of zero residual had been seen.
-        ``30`` suits CMU subject 35 at 30 frames per second (see Notes).
+        at hand (see Notes).  ``None``: no correction (with
+        ``n_particles=1``, the paper's fill-in exactly).  A number ``lam >=
+        0``: a missing entry of channel ``j`` is shifted by ``sum(r) / (n +
+        lam)``, where ``r`` are the channel's one-step residuals (observed
+        value minus the chain's mean-field prediction from its past) over
+        the ``n`` frames of the sequence in which it was observed so far:
+        the mean residual, shrunk towards 0 as if ``lam`` frames of zero
+        residual had been seen.  Binary visibles' fills are probabilities
+        and are kept in [0, 1].  ``30`` suits CMU subject 35 at 30 frames
+        per second (see Notes).
     missing_values : int, float, str, np.nan or None, default=np.nan
         The placeholder for missing values; all its occurrences are filled.
     random_state : int, RandomState instance or None, default=None
@@ -244,7 +248,7 @@ class CRBMImputer(
         *,
         n_gibbs=30,
         n_draws=1,
-        n_particles=10,
+        n_particles=20,
         offset_shrinkage=30.0,
         missing_values=np.nan,
         random_state=None,

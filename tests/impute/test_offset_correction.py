@@ -132,3 +132,18 @@ def test_negative_shrinkage_is_rejected(data):
     imputer = CRBMImputer(ConditionalRBM(3, n_iter=1), offset_shrinkage=-1)
     with pytest.raises(InvalidParameterError, match="offset_shrinkage"):
         imputer.fit(X)
+
+
+def test_binary_fills_stay_probabilities():
+    """A channel on throughout, where the model expects it half the time."""
+    X, ids = make_oscillations(n_sequences=5, n_frames=60, n_features=4, random_state=0)
+    B = (X > 0).astype(float)
+    model = ConditionalRBM(8, order=2, n_iter=30, visible_type="binary", random_state=0)
+    imputer = CRBMImputer(model, offset_shrinkage=0.0, random_state=0)
+    imputer.fit(B[ids < 4], sequence_ids=ids[ids < 4])
+    X_missing = B[ids == 4].copy()
+    X_missing[:, 0] = 1.0
+    X_missing[30:, 0] = np.nan
+    filled = imputer.transform(X_missing)
+    assert filled[30:, 0].max() == 1.0  # the correction reaches the bound ...
+    assert (filled >= 0).all() and (filled <= 1).all()  # ... and stops there
