@@ -29,16 +29,22 @@ What ``GridSearchCV(scoring=None)`` does with a ConditionalRBM, measured:
   AR(order) (penalty 10) with a per-channel residual variance (at least
   0.01), its closed-form held-out log-likelihood per frame.
 
-Every (configuration, fold) result is cached as JSON under
-``benchmarks/results/model_selection_cache/``, so a subset
-(``--sizes 10 50 --orders 1 --folds 0``) can run first and the full grid
-later reuses it.  Run from the repository root, with one BLAS thread::
+Every fitted model (pickle), its score and every (configuration, fold)
+result are cached under ``benchmarks/results/model_selection_cache/``, keyed
+on every parameter of the ConditionalRBM and of the CRBMImputer, defaults
+included: a subset (``--sizes 10 50 --orders 1 --folds 0``) can run first
+and the full grid later reuses it, a changed default fits or fills again, and
+``--paper-fillin`` (the paper's single chain, ``n_particles=1,
+offset_shrinkage=None``) fills the same models without refitting them.
+``model_selection_diagnostics.py`` reads the cached models.  Run from the
+repository root, with one BLAS thread::
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/model_selection.py
     OPENBLAS_NUM_THREADS=1 python benchmarks/model_selection.py --sizes 10 50 --orders 0 1
 
 Prints a table and writes ``benchmarks/results/model_selection_hn{noise}.json``
-(``--history-noise``, default the estimator's).
+(``--history-noise``, default the estimator's; ``_paper_fillin`` appended
+with ``--paper-fillin``).
 """
 
 import argparse
@@ -202,9 +208,7 @@ def _digest(estimator, leave_out=()):
     Part of every cache key, so that a changed default is a new key.
     """
     params = {
-        k: v
-        for k, v in estimator.get_params(deep=False).items()
-        if k not in leave_out
+        k: v for k, v in estimator.get_params(deep=False).items() if k not in leave_out
     }
     return hashlib.sha1(repr(sorted(params.items())).encode()).hexdigest()[:8]
 
@@ -222,7 +226,9 @@ def fitted_model(data, n_components, order, fold, args):
     key = model_key(n_components, order, fold, args)
     model_path, result_path = CACHE / f"{key}.pkl", CACHE / f"{key}.fit.json"
     if model_path.exists() and result_path.exists() and not args.no_cache:
-        return pickle.loads(model_path.read_bytes()), json.loads(result_path.read_text())
+        return pickle.loads(model_path.read_bytes()), json.loads(
+            result_path.read_text()
+        )
     model = ConditionalRBM(**model_parameters(n_components, order, args))
     start = time.process_time()
     model.fit(data["Z_train"], sequence_ids=data["train_ids"])

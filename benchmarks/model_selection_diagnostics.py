@@ -15,7 +15,18 @@ unless asked (``--seeds``):
   affordable;
 - ``seeds``: the same grid retrained with other ``random_state`` values
   (cached like the main grid), for the spread of score and fill-in across
-  training seeds.
+  training seeds;
+- ``conditional``: ``log p(erased channels | observed ones, clean past)``,
+  exactly as an RBM on the erased channels (or annealed);
+- ``spread``: the model's distribution of a frame given its clean past, a
+  mixture of unit-variance Gaussians: the error of its mean and the spread of
+  its components, by Gibbs sampling;
+- ``prediction``: the one-step prediction scorer beside the score;
+- ``epochs``: score and fill-in error as training goes on (refits, with
+  ``partial_fit``).
+
+``--paper-fillin`` uses the paper's single-chain fill-in, as in
+``model_selection.py``.  The findings are in ``benchmarks/README.md``.
 
 Run from the repository root, with one BLAS thread::
 
@@ -50,14 +61,16 @@ from sklearn_crbm import ConditionalRBM
 from sklearn_crbm._crbm_math import sequence_dynamic_biases
 from sklearn_crbm._likelihood import FrameRBMs, log_partition
 from sklearn_crbm.impute import CRBMImputer
+from sklearn_crbm.model_selection import erasure_mask, make_prediction_scorer
 from sklearn_crbm.utils._sequences import check_sequence_ids
-from sklearn_crbm.model_selection import erasure_mask
 
 DIAGNOSTICS = RESULTS / "model_selection_diagnostics"
 
 
 def _args_for(args, seed=None):
-    return argparse.Namespace(**{**vars(args), "seed": args.seed if seed is None else seed})
+    return argparse.Namespace(
+        **{**vars(args), "seed": args.seed if seed is None else seed}
+    )
 
 
 def key_of(n_components, order, fold, args, seed=None):
@@ -192,7 +205,9 @@ def fillin_draws(args):
                     continue
                 data = load_fold(args.data_home, fold) if data is None else data
                 model = cached_model(size, order, fold, args)
-                imputer = _imputer_for(model, data, args.fill_seed, imputer_parameters(args))
+                imputer = _imputer_for(
+                    model, data, args.fill_seed, imputer_parameters(args)
+                )
                 result = dict(n_components=size, order=order, fold=fold)
                 start = time.process_time()
                 for part, bones in data["parts"].items():
@@ -243,7 +258,8 @@ def summarise_fillin(args, results):
             ]
             draws = np.mean(
                 [
-                    0.5 * (np.array(r["left leg draws"]) + np.array(r["upper body draws"]))
+                    0.5
+                    * (np.array(r["left leg draws"]) + np.array(r["upper body draws"]))
                     for r in runs
                 ],
                 axis=0,
@@ -251,7 +267,9 @@ def summarise_fillin(args, results):
             score = np.mean(
                 [cached_result(size, order, r["fold"], args)["score"] for r in runs]
             )
-            single = np.mean([fill(cached_result(size, order, r["fold"], args)) for r in runs])
+            single = np.mean(
+                [fill(cached_result(size, order, r["fold"], args)) for r in runs]
+            )
             rows.append(
                 dict(
                     config=f"{size} x {order}",
@@ -263,7 +281,8 @@ def summarise_fillin(args, results):
                     mean_fill=float(
                         np.mean(
                             [
-                                0.5 * (r["left leg mean fill"] + r["upper body mean fill"])
+                                0.5
+                                * (r["left leg mean fill"] + r["upper body mean fill"])
                                 for r in runs
                             ]
                         )
@@ -388,7 +407,9 @@ def other_seeds(args):
     for fold in args.folds:
         data = load_fold(args.data_home, fold)
         for seed in args.seeds:
-            run_args = argparse.Namespace(**{**vars(args), "seed": seed, "no_cache": False})
+            run_args = argparse.Namespace(
+                **{**vars(args), "seed": seed, "no_cache": False}
+            )
             for order in args.orders:
                 for size in args.sizes:
                     r = run_one(data, size, order, fold, run_args)
@@ -422,7 +443,9 @@ def epochs(args):
                 model.fit(data["Z_train"], sequence_ids=data["train_ids"])
                 for epoch in checkpoints:
                     while model.n_iter_ < epoch:
-                        model.partial_fit(data["Z_train"], sequence_ids=data["train_ids"])
+                        model.partial_fit(
+                            data["Z_train"], sequence_ids=data["train_ids"]
+                        )
                     score = model.score(data["Z_test"], sequence_ids=data["test_ids"])
                     errors = fillin(model, data, args.seed, imputer_parameters(args))
                     row = dict(
@@ -489,7 +512,13 @@ def conditional(args):
                     frames = np.flatnonzero(mask.any(axis=1))
                     missing = mask[frames[0]]
                     cond, joint = _conditional_log_likelihood(
-                        params, model._visible_scale(), X, sequences, frames, missing, args
+                        params,
+                        model._visible_scale(),
+                        X,
+                        sequences,
+                        frames,
+                        missing,
+                        args,
                     )
                     row[f"{part} cond"] = float(cond.mean())
                     row[f"{part} joint"] = float(joint.mean())
@@ -548,13 +577,23 @@ def _conditional_log_likelihood(params, scale, X, sequences, frames, missing, ar
         x = X[rows]
         full = FrameRBMs(params, visible_bias, hidden_bias, scale)
         log_z, _, _ = log_partition(
-            full, method="auto", n_steps=args.cond_steps, n_chains=args.cond_chains, rng=rng
+            full,
+            method="auto",
+            n_steps=args.cond_steps,
+            n_chains=args.cond_chains,
+            rng=rng,
         )
         joint.append(full.negative_free_energy(x) - log_z)
-        hidden = hidden_bias + (x[:, ~missing] / scale[~missing]) @ weights[:, ~missing].T
+        hidden = (
+            hidden_bias + (x[:, ~missing] / scale[~missing]) @ weights[:, ~missing].T
+        )
         rbms = FrameRBMs(sub, visible_bias[:, missing], hidden, scale[missing])
         log_z, _, _ = log_partition(
-            rbms, method="auto", n_steps=args.cond_steps, n_chains=args.cond_chains, rng=rng
+            rbms,
+            method="auto",
+            n_steps=args.cond_steps,
+            n_chains=args.cond_chains,
+            rng=rng,
         )
         cond.append(rbms.negative_free_energy(x[:, missing]) - log_z)
     return np.concatenate(cond), np.concatenate(joint)
@@ -592,7 +631,9 @@ def spread(args):
         for order in args.orders:
             for size in args.sizes:
                 model = cached_model(size, order, fold, args)
-                error, mix, ar = _mixture_moments(model._parameters, X, sequences, frames, args)
+                error, mix, ar = _mixture_moments(
+                    model._parameters, X, sequences, frames, args
+                )
                 r = cached_result(size, order, fold, args)
                 row = dict(
                     fold=fold,
@@ -660,9 +701,68 @@ def _mixture_moments(params, X, sequences, frames, args):
     return (float(np.concatenate(v).mean()) for v in (error, mix, ar))
 
 
+# ------------------------------------------------------------------ prediction
+
+
+def prediction(args):
+    """The one-step prediction scorer beside the score, against the fill-in error."""
+    scorer = make_prediction_scorer()
+    rows = []
+    for fold in args.folds:
+        data = load_fold(args.data_home, fold)
+        for order in args.orders:
+            for size in args.sizes:
+                model = cached_model(size, order, fold, args)
+                r = cached_result(size, order, fold, args)
+                rows.append(
+                    dict(
+                        fold=fold,
+                        config=f"{size} x {order}",
+                        order=order,
+                        score=r["score"],
+                        prediction=scorer(
+                            model, data["Z_test"], sequence_ids=data["test_ids"]
+                        ),
+                        fillin=fill(r),
+                    )
+                )
+    table = _mean_over_folds(rows)
+    print_table(
+        table,
+        [
+            ("config", "hidden x order", "s"),
+            ("score", "score", ".3f"),
+            ("prediction", "-one-step MSE", ".4f"),
+            ("fillin", "fill-in", ".3f"),
+        ],
+        title=f"one-step prediction, history_noise {args.history_noise:g}",
+    )
+    for label, minimum in (("order >= 1", 1), ("all", 0)):
+        sub = [r for r in table if r["order"] >= minimum]
+        print(
+            f"{label}: Spearman(score, -fill-in) "
+            f"{spearman([r['score'] for r in sub], [-r['fillin'] for r in sub]):.3f}, "
+            f"Spearman(-one-step MSE, -fill-in) "
+            f"{spearman([r['prediction'] for r in sub], [-r['fillin'] for r in sub]):.3f}"
+        )
+    return dict(rows=rows)
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("what", choices=["breakdown", "fillin", "ais", "seeds", "epochs", "conditional", "spread"])
+    parser.add_argument(
+        "what",
+        choices=[
+            "breakdown",
+            "fillin",
+            "ais",
+            "seeds",
+            "epochs",
+            "conditional",
+            "spread",
+            "prediction",
+        ],
+    )
     parser.add_argument("--data-home", default=str(DEFAULT_DATA_HOME))
     parser.add_argument("--sizes", type=int, nargs="+", default=[10, 50, 200, 400])
     parser.add_argument("--orders", type=int, nargs="+", default=[0, 1, 3, 6])
@@ -693,6 +793,7 @@ def main(argv=None):
         epochs=epochs,
         conditional=conditional,
         spread=spread,
+        prediction=prediction,
     )[args.what]
     out = run(args)
     write_json(
