@@ -26,7 +26,7 @@ from ._crbm_math import (
     MomentumUpdate,
     cd_gradients,
 )
-from .utils._array_api import array_ops, array_random
+from .utils._array_api import array_ops, array_random, to_device_batches
 from .utils._autoregression import ridge_autoregression
 from .utils._fitting import unfitted_on_error
 from .utils._random import rng_from
@@ -593,8 +593,11 @@ class ConditionalRBM(BaseCRBM):
             math_rng = array_random(rng, X)
             momentum = self.momentum if self.n_iter_ >= self.momentum_delay else 0.0
             squared_error = 0.0
-            for batch in plan_batches(frames, self.batch_size, rng):
-                n = len(batch)
+            batches = plan_batches(frames, self.batch_size, rng)
+            if ops is not np:  # the epoch's plan reaches the device in one copy
+                batches = to_device_batches(batches, ops)
+            for batch in batches:
+                n = batch.shape[0]
                 visible = ops.take(
                     X, batch, axis=0, out=workspace.visible(n), mode="clip"
                 )
@@ -668,12 +671,12 @@ class ConditionalRBM(BaseCRBM):
         while self.n_iter_ < self.n_iter:
             epochs = min(self.validation_interval, self.n_iter - self.n_iter_)
             self._train(X_train, train_frames, epochs)
-            score = (
-                self._log_likelihood(X_valid, valid, rng=np.random.default_rng(seed))
-                .log_likelihood[valid_frames]
-                .mean()
-            )
-            self.validation_scores_.append(float(score))
+            log_likelihood = self._log_likelihood(
+                X_valid, valid, rng=np.random.default_rng(seed)
+            ).log_likelihood
+            ops = array_ops(log_likelihood)
+            score = float(ops.mean(ops.take(log_likelihood, valid_frames, axis=0)))
+            self.validation_scores_.append(score)
             if score > best + self.tol or best_parameters is None:
                 best, best_iter = float(score), self.n_iter_
                 best_parameters = self._parameters.copy()

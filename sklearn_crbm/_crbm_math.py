@@ -298,9 +298,7 @@ class CRBMParameters:
     @property
     def decayed(self):
         """The prefix of :attr:`flat` that weight decay applies to."""
-        size = sum(
-            math.prod(getattr(self, g.name).shape) for g in GROUPS if g.decayed
-        )
+        size = sum(math.prod(getattr(self, g.name).shape) for g in GROUPS if g.decayed)
         return slice(0, size)
 
     @classmethod
@@ -770,8 +768,9 @@ def cd_gradients(
     gradients : CRBMParameters
         Sums over the batch (not means), group by group; ascent directions
         (``out`` if given).
-    squared_error : float
-        Sum over the batch of ``||v - v_recon||^2``.
+    squared_error : float or 0-d array
+        Sum over the batch of ``||v - v_recon||^2`` (a 0-d array of the
+        namespace for other namespaces than numpy).
     """
     n, d = visible.shape
     ops = params.ops
@@ -782,7 +781,10 @@ def cd_gradients(
     stacked_visible = workspace.visible_stack[: 2 * n, ...]
     stacked_hidden = workspace.hidden_stack[: 2 * n, ...]
     data, reconstruction = stacked_visible[:n, ...], stacked_visible[n:, ...]
-    positive_states, negative_probabilities = stacked_hidden[:n, ...], stacked_hidden[n:, ...]
+    positive_states, negative_probabilities = (
+        stacked_hidden[:n, ...],
+        stacked_hidden[n:, ...],
+    )
     if not same_memory(visible, data):
         ops.copyto(data, visible)
 
@@ -798,7 +800,9 @@ def cd_gradients(
     for step in range(cd_steps):
         visible_means(params, hidden, visible_bias, out=reconstruction)
         if learned and step == 0:
-            ops.subtract(reconstruction, visible_bias, out=workspace.first_mean[:n, ...])
+            ops.subtract(
+                reconstruction, visible_bias, out=workspace.first_mean[:n, ...]
+            )
         if step + 1 < cd_steps:
             with np.errstate(over="ignore", under="ignore", invalid="ignore"):
                 hidden = sample_hidden(
@@ -816,7 +820,7 @@ def cd_gradients(
     visible_delta = ops.subtract(data, reconstruction, out=delta[:, :d])
     ops.subtract(positive_states, negative_probabilities, out=delta[:, d:])
     squared_error = ops.einsum("ij,ij->", visible_delta, visible_delta)
-    if ops is np:  # elsewhere a device scalar: no synchronisation per minibatch
+    if ops is np:  # elsewhere it stays on the device: no sync per minibatch
         squared_error = float(squared_error)
 
     if learned:

@@ -462,9 +462,7 @@ def shared_log_partition_ais(rbms, starts, n_steps, n_chains, rng):
     ops = rbms.ops
     rbms = rbms.take(np.zeros(starts.shape[0], dtype=np.intp))
     log_weights = [
-        _forward_log_weights(
-            rbms.take(rows), n_steps, n_chains, rng, starts[rows, ...]
-        )
+        _forward_log_weights(rbms.take(rows), n_steps, n_chains, rng, starts[rows, ...])
         for rows in _row_blocks(starts.shape[0], n_chains)
     ]
     log_z, error = _log_mean_exp(ops.reshape(ops.concatenate(log_weights), (1, -1)))
@@ -637,7 +635,12 @@ def _chunk_log_likelihoods(
         if params.n_lags == 0:
             if shared is None:
                 shared = _shared_log_partition(
-                    rbms, visible[rows], method, n_steps, n_chains, rng
+                    rbms,
+                    rbms.ops.take(visible, rows, axis=0),
+                    method,
+                    n_steps,
+                    n_chains,
+                    rng,
                 )
             log_z, error, used = shared
         else:
@@ -712,9 +715,7 @@ def stack_log_likelihood_bound(layers, visible, biases, *, n_samples, rng, **top
             )
             logits = rbms.hidden_input(state)
             hidden = _bernoulli(logistic(copy_array(logits)), rng)
-            log_weight -= ops.sum(
-                hidden * logits - ops.logaddexp(0, logits), axis=1
-            )
+            log_weight -= ops.sum(hidden * logits - ops.logaddexp(0, logits), axis=1)
             log_weight += _log_visible_given_hidden(rbms, state, hidden)
             state = hidden
         params, scale = layers[-1]

@@ -29,7 +29,7 @@ from ._crbm_math import (
     stacked_prediction,
     visible_means,
 )
-from .utils._array_api import array_ops, copy_array
+from .utils._array_api import copy_array
 from .utils._sequences import Sequences
 
 # How a stack draws a frame (``scheme`` of run_online).  With one layer the two

@@ -15,6 +15,7 @@ import pickle
 import numpy as np
 import pytest
 import sklearn
+from sklearn.frozen import FrozenEstimator
 from sklearn.utils._array_api import (
     _convert_to_numpy,
     get_namespace_and_device,
@@ -329,3 +330,82 @@ def test_stack_fits_and_runs_on_the_input_device_as_on_numpy(
         )
     # a bound from ten draws per frame: other draws, nearly the same mean
     assert abs(moved.score(X_xp, sequence_ids=ids) - expected_score) < 0.05
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_autoregressive_start_lands_on_the_input_device(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    settings = dict(order=2, n_iter=1, init="autoregressive", random_state=0)
+    settings["visible_variance"] = "learned"
+    X_xp = _to(xp, device, X)
+    model = ConditionalRBM(6, **settings).fit(X_xp, sequence_ids=ids)
+    with sklearn.config_context(array_api_dispatch=False):
+        expected = ConditionalRBM(6, **settings).fit(X, sequence_ids=ids)
+    for name in ("autoregressive_", "intercept_visible_", "visible_variance_"):
+        _same_place(getattr(model, name), X_xp)
+        # the same ridge start; one epoch of other random numbers moves it little
+        np.testing.assert_allclose(
+            _numpy(getattr(model, name)), getattr(expected, name), atol=2e-3
+        )
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+@pytest.mark.parametrize("n_components", [6, 30])  # exact; one shared annealing
+def test_binary_model_without_history_scores_as_on_numpy(
+    namespace, device_name, dtype_name, n_components, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    X = (X > 0).astype(X.dtype)
+    with sklearn.config_context(array_api_dispatch=False):
+        model = ConditionalRBM(
+            n_components, order=0, visible_type="binary", n_iter=2, random_state=0
+        ).fit(X, sequence_ids=ids)
+        expected = model.score(X, sequence_ids=ids)
+    moved = move_estimator_to(model, xp, device)
+    X_xp = _to(xp, device, X)
+    tolerance = 1e-4 if n_components == 6 else 0.01
+    assert moved.score(X_xp, sequence_ids=ids) == pytest.approx(expected, abs=tolerance)
+    _same_place(moved.sample(2, n_sequences=2, random_state=0), X_xp)
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_early_stopping_validates_on_the_input_device(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = make_oscillations(n_sequences=6, n_frames=40, random_state=0)
+    X = X.astype(dtype_name)
+    settings = dict(order=2, n_iter=20, early_stopping=True, random_state=0)
+    settings["validation_interval"] = 5
+    model = ConditionalRBM(6, **settings).fit(_to(xp, device, X), sequence_ids=ids)
+    with sklearn.config_context(array_api_dispatch=False):
+        expected = ConditionalRBM(6, **settings).fit(X, sequence_ids=ids)
+    # the same held-out sequences and start; other random numbers in training
+    np.testing.assert_allclose(
+        model.validation_scores_, expected.validation_scores_, atol=0.05
+    )
+    _same_place(model.components_, _to(xp, device, X))
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_imputer_refuses_a_frozen_model_of_another_namespace_clearly(
+    namespace, device_name, dtype_name
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    with sklearn.config_context(array_api_dispatch=True):
+        model = ConditionalRBM(6, order=2, n_iter=1, random_state=0)
+        model.fit(_to(xp, device, X), sequence_ids=ids)
+    imputer = CRBMImputer(FrozenEstimator(model))
+    with pytest.raises(TypeError, match="move_estimator_to"):
+        imputer.fit(X, sequence_ids=ids)
+    # moved to numpy, the same model fills
+    imputer = CRBMImputer(FrozenEstimator(move_estimator_to(model, np, None)))
+    X_missing = X.copy()
+    X_missing[5:9, 1] = np.nan
+    filled = imputer.fit(X, sequence_ids=ids).transform(X_missing, sequence_ids=ids)
+    assert np.isfinite(filled).all()

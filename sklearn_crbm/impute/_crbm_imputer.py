@@ -474,4 +474,11 @@ def _check_frozen(model, n_features):
             f"{model.n_features_in_} features but X has {n_features}: fit the "
             "imputer on data with the model's features (same preprocessing)."
         )
+    flat = model._packed_parameters
+    if not isinstance(flat, np.ndarray):
+        raise TypeError(
+            f"The frozen {type(model).__name__} holds {type(flat).__module__} "
+            "arrays; CRBMImputer fills with numpy only. Move the model first: "
+            "sklearn.utils._array_api.move_estimator_to(model, numpy, 'cpu')."
+        )
     return model

@@ -32,6 +32,7 @@ __all__ = [
     "copy_array",
     "is_numpy",
     "same_memory",
+    "to_device_batches",
 ]
 
 
@@ -63,8 +64,18 @@ class ArrayOps:
         self.xp = xp
         self.device = device
         for name in (
-            "float32", "float64", "bool", "int64",
-            "isfinite", "all", "any", "min", "max", "reshape", "permute_dims", "sqrt",
+            "float32",
+            "float64",
+            "bool",
+            "int64",
+            "isfinite",
+            "all",
+            "any",
+            "min",
+            "max",
+            "reshape",
+            "permute_dims",
+            "sqrt",
         ):
             setattr(self, name, getattr(xp, name))
         for name in ("exp", "log", "log1p", "tanh", "abs", "square"):
@@ -312,3 +323,13 @@ def same_memory(a, b):
     if hasattr(a, "data_ptr") and hasattr(b, "data_ptr"):
         return a.data_ptr() == b.data_ptr()
     return False
+
+
+def to_device_batches(batches, ops):
+    """Index arrays ``batches`` on the device of ``ops``, moved in one copy."""
+    lengths = [len(batch) for batch in batches]
+    flat = ops.asarray(np.concatenate(batches).astype(np.int64, copy=False))
+    stops = np.cumsum(lengths)
+    return [
+        flat[stop - length : stop] for stop, length in zip(stops, lengths, strict=True)
+    ]

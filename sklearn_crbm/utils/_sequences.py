@@ -229,12 +229,22 @@ def frame_history(X, frames, n_lags, frame_starts=None, out=None):
     Returns an array of shape ``(len(frames), n_lags * n_features)`` whose
     block ``q - 1`` holds frame ``t - q``.
     """
-    indices = history_indices(frames, n_lags, frame_starts)
     n_features = X.shape[1]
+    on_device = hasattr(frames, "__array_namespace__") and not isinstance(
+        frames, np.ndarray
+    )
+    if on_device and frame_starts is None:
+        # frames on the device (a training minibatch): indices there too
+        lags = array_ops(frames).arange(1, n_lags + 1, dtype=frames.dtype)
+        indices = frames[:, None] - lags
+    else:
+        indices = history_indices(frames, n_lags, frame_starts)
     if not isinstance(X, np.ndarray):  # another array API namespace
         ops = array_ops(X)
-        gathered = ops.take(X, indices.ravel(), axis=0)
-        flat = ops.reshape(gathered, (len(indices), n_lags * n_features))
+        if isinstance(indices, np.ndarray):
+            indices = ops.asarray(indices)
+        gathered = ops.take(X, ops.reshape(indices, (-1,)), axis=0)
+        flat = ops.reshape(gathered, (indices.shape[0], n_lags * n_features))
         return ops._into(out, flat)
     if out is None:
         return X[indices.ravel()].reshape(len(indices), n_lags * n_features)
