@@ -25,6 +25,7 @@ from ._crbm_math import (
     CRBMParameters,
     MomentumUpdate,
     cd_gradients,
+    standard_normal,
 )
 from .utils._array_api import array_ops, array_random, to_device_batches
 from .utils._autoregression import ridge_autoregression
@@ -591,6 +592,7 @@ class ConditionalRBM(BaseCRBM):
         n_lags = params.n_lags
         # Buffers reused by every minibatch
         workspace = CDWorkspace(params, self.batch_size)
+        noise_buffer = ops.empty_like(workspace.history) if self.history_noise else None
         start = time.perf_counter()
         for _ in range(n_epochs):
             rng = rng_from(self.random_state_)
@@ -610,9 +612,11 @@ class ConditionalRBM(BaseCRBM):
                     X, batch, n_lags, out=workspace.history[:n, ...]
                 )
                 if self.history_noise:
-                    batch_history += self.history_noise * math_rng.standard_normal(
-                        batch_history.shape, dtype=batch_history.dtype
+                    noise = standard_normal(
+                        math_rng, batch_history.shape, X.dtype, noise_buffer[:n, ...]
                     )
+                    noise *= self.history_noise
+                    batch_history += noise
                 _, error = cd_gradients(
                     params,
                     visible,

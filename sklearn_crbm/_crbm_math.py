@@ -86,6 +86,43 @@ def uniform(rng, shape, dtype, out=None, *, symmetric=False):
     return np.subtract(floats, 3 if symmetric else 1, out=out)
 
 
+def standard_normal(rng, shape, dtype, out=None):
+    """Standard normal draws in ``dtype``.
+
+    float64 draws (and fewer than ``_MIN_BIT_DRAWS`` float32 ones, and any
+    other namespace's) are ``rng.standard_normal``'s.  Larger float32 arrays
+    come from the Box-Muller transform of :func:`uniform`'s 23-bit draws,
+    ``sqrt(-2 log(1 - u)) * (cos, sin)(2 pi u')``: a pair of normals per
+    64 random bits in a few vectorised passes, about four times faster than
+    numpy's float32 ziggurat (which draws one at a time), and the history
+    noise of every training minibatch is that many draws.  Its tails stop at
+    ``sqrt(46 log 2) = 5.65`` standard deviations (probability 2e-8 beyond).
+    """
+    size = math.prod(shape)
+    if (
+        not isinstance(rng, np.random.Generator)
+        or np.dtype(dtype) != np.float32
+        or size < _MIN_BIT_DRAWS
+    ):
+        return rng.standard_normal(shape, dtype=dtype, out=out)
+    half = (size + 1) // 2
+    radius, angle = uniform(rng, (2, half), np.float32)
+    np.subtract(1, radius, out=radius)  # (0, 1]: log(0) never taken
+    np.log(radius, out=radius)
+    radius *= -2
+    np.sqrt(radius, out=radius)
+    angle *= np.float32(2 * np.pi)
+    draws = np.empty((2, half), np.float32)
+    np.cos(angle, out=draws[0])
+    np.sin(angle, out=draws[1])
+    draws *= radius
+    draws = draws.reshape(-1)[:size].reshape(shape)
+    if out is None:
+        return draws
+    out[...] = draws
+    return out
+
+
 def logistic(activation, out=None):
     """The logistic sigmoid ``1 / (1 + exp(-a))``, elementwise, in the dtype of ``a``.
 

@@ -10,6 +10,7 @@ import warnings
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
+from scipy import stats
 from scipy.special import expit
 
 from sklearn_crbm._crbm_math import (
@@ -22,6 +23,7 @@ from sklearn_crbm._crbm_math import (
     gibbs_frames,
     hidden_probabilities,
     logistic,
+    standard_normal,
     uniform,
 )
 
@@ -95,6 +97,37 @@ def test_float32_uniform_draws_are_the_bit_generators_mantissas():
     assert_array_equal(draws.ravel(), expected.astype(np.float32))
     small = uniform(np.random.default_rng(4), (3, 5), np.float32)
     assert_array_equal(small, np.random.default_rng(4).random((3, 5), np.float32))
+
+
+@pytest.mark.parametrize("shape", [(3, 5), (400, 251)])
+def test_float64_and_small_float32_normal_draws_are_the_generators_own(shape):
+    expected = np.random.default_rng(4).standard_normal(shape)
+    draws = standard_normal(np.random.default_rng(4), shape, np.float64)
+    assert_array_equal(draws, expected)
+    small = standard_normal(np.random.default_rng(4), (3, 5), np.float32)
+    expected = np.random.default_rng(4).standard_normal((3, 5), np.float32)
+    assert_array_equal(small, expected)
+
+
+def test_float32_normal_draws_are_box_muller_of_the_uniforms():
+    shape = (400, 251)  # an odd number of draws, enough for the bit route
+    size, half = 400 * 251, (400 * 251 + 1) // 2
+    u, v = uniform(np.random.default_rng(4), (2, half), np.float32).astype(float)
+    radius = np.sqrt(-2 * np.log1p(-u))
+    expected = np.concatenate(
+        [radius * np.cos(2 * np.pi * v), radius * np.sin(2 * np.pi * v)]
+    )
+    draws = standard_normal(np.random.default_rng(4), shape, np.float32)
+    assert draws.dtype == np.float32 and draws.shape == shape
+    assert_allclose(draws.ravel(), expected[:size], rtol=1e-5, atol=1e-5)
+    # standard normal: 10^5 draws pass Kolmogorov-Smirnov, pairs uncorrelated
+    assert stats.kstest(draws.ravel().astype(float), "norm").pvalue > 1e-3
+    assert (
+        abs(np.corrcoef(draws.ravel()[: half - 1], draws.ravel()[half:-1])[0, 1]) < 0.02
+    )
+    out = np.empty(shape, np.float32)
+    assert standard_normal(np.random.default_rng(4), shape, np.float32, out) is out
+    assert_array_equal(out, draws)
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
