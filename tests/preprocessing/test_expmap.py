@@ -133,7 +133,9 @@ def test_inverse_round_trip_property(case, unit):
     back = encoder.inverse_transform(encoder.transform(X))
     R = euler_to_matrix(X if unit == "rad" else np.deg2rad(X), axes)
     R_back = euler_to_matrix(back if unit == "rad" else np.deg2rad(back), axes)
-    assert np.allclose(R_back, R, atol=1e-13)
+    # A rotation within _PI_TIE_TOL (1e-12) of a half turn is encoded as the
+    # half turn itself, which moves the matrix by up to a few times that.
+    assert np.allclose(R_back, R, atol=1e-11)
     # Unique Euler angles come back themselves: always for one or two axes (the
     # absent angle is zero), for three when the middle one is inside (-90, 90).
     if len(axes) < 3 or abs(_wrapped_deg(angles[1], 0.0)) < 90.0 - 1e-6:
