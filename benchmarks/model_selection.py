@@ -29,20 +29,28 @@ What ``GridSearchCV(scoring=None)`` does with a ConditionalRBM, measured:
   AR(order) (penalty 10) with a per-channel residual variance (at least
   0.01), its closed-form held-out log-likelihood per frame.
 
-Every (configuration, fold) result is cached as JSON under
-``benchmarks/results/model_selection_cache/``, so a subset
-(``--sizes 10 50 --orders 1 --folds 0``) can run first and the full grid
-later reuses it.  Run from the repository root, with one BLAS thread::
+Every fitted model (pickle), its score and every (configuration, fold)
+result are cached under ``benchmarks/results/model_selection_cache/``, keyed
+on every parameter of the ConditionalRBM and of the CRBMImputer, defaults
+included: a subset (``--sizes 10 50 --orders 1 --folds 0``) can run first
+and the full grid later reuses it, a changed default fits or fills again, and
+``--paper-fillin`` (the paper's single chain, ``n_particles=1,
+offset_shrinkage=None``) fills the same models without refitting them.
+``model_selection_diagnostics.py`` reads the cached models.  Run from the
+repository root, with one BLAS thread::
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/model_selection.py
     OPENBLAS_NUM_THREADS=1 python benchmarks/model_selection.py --sizes 10 50 --orders 0 1
 
 Prints a table and writes ``benchmarks/results/model_selection_hn{noise}.json``
-(``--history-noise``, default the estimator's).
+(``--history-noise``, default the estimator's; ``_paper_fillin`` appended
+with ``--paper-fillin``).
 """
 
 import argparse
+import hashlib
 import json
+import pickle
 import time
 
 import numpy as np
@@ -97,9 +105,9 @@ def load_fold(data_home, fold):
     )
 
 
-def fillin(model, data, seed):
+def fillin(model, data, seed, imputer_params=None):
     """Mean squared error per erased entry (z-scores), left leg and upper body."""
-    imputer = _imputer_for(model, data, seed)
+    imputer = _imputer_for(model, data, seed, imputer_params or {})
     errors = {}
     for part, bones in data["parts"].items():
         mask = erasure_mask(
@@ -119,17 +127,10 @@ def fillin(model, data, seed):
     return errors
 
 
-def _imputer_for(model, data, seed):
+def _imputer_for(model, data, seed, params):
     """CRBMImputer on the fitted model, without training it again."""
-    imputer = CRBMImputer(FrozenEstimator(model), random_state=seed)
-    try:
-        return imputer.fit(data["Z_train"], sequence_ids=data["train_ids"])
-    except TypeError:  # a CRBMImputer that does not know FrozenEstimator yet
-        imputer = CRBMImputer(model, random_state=seed)
-        imputer.estimator_ = model
-        imputer.mean_ = data["Z_train"].mean(axis=0)
-        imputer.n_features_in_ = model.n_features_in_
-        return imputer
+    imputer = CRBMImputer(FrozenEstimator(model), random_state=seed, **params)
+    return imputer.fit(data["Z_train"], sequence_ids=data["train_ids"])
 
 
 def generation_error(model, data, seed):
@@ -185,37 +186,80 @@ def history_noise(args):
     return args.history_noise
 
 
-def run_one(data, n_components, order, fold, args):
-    noise = history_noise(args)
-    key = f"h{n_components}_o{order}_f{fold}_it{args.n_iter}_s{args.seed}_hn{noise:g}"
-    path = CACHE / f"{key}.json"
-    if path.exists() and not args.no_cache:
-        return json.loads(path.read_text())
-    model = ConditionalRBM(
-        n_components,
+def model_parameters(n_components, order, args):
+    """The ConditionalRBM of a grid cell: the options given, defaults otherwise."""
+    return dict(
+        n_components=n_components,
         order=order,
         n_iter=args.n_iter,
-        history_noise=noise,
+        history_noise=history_noise(args),
         random_state=args.seed,
     )
+
+
+def imputer_parameters(args):
+    """The fill-in procedure: CRBMImputer's defaults, or the paper's single chain."""
+    return dict(n_particles=1, offset_shrinkage=None) if args.paper_fillin else {}
+
+
+def _digest(estimator, leave_out=()):
+    """Eight hex digits naming every parameter of ``estimator``, defaults included.
+
+    Part of every cache key, so that a changed default is a new key.
+    """
+    params = {
+        k: v for k, v in estimator.get_params(deep=False).items() if k not in leave_out
+    }
+    return hashlib.sha1(repr(sorted(params.items())).encode()).hexdigest()[:8]
+
+
+def model_key(n_components, order, fold, args):
+    params = model_parameters(n_components, order, args)
+    return (
+        f"h{n_components}_o{order}_f{fold}_it{args.n_iter}_s{args.seed}"
+        f"_hn{params['history_noise']:g}_{_digest(ConditionalRBM(**params))}"
+    )
+
+
+def fitted_model(data, n_components, order, fold, args):
+    """The fitted model of a grid cell and its score, cached (pickle and JSON)."""
+    key = model_key(n_components, order, fold, args)
+    model_path, result_path = CACHE / f"{key}.pkl", CACHE / f"{key}.fit.json"
+    if model_path.exists() and result_path.exists() and not args.no_cache:
+        return pickle.loads(model_path.read_bytes()), json.loads(
+            result_path.read_text()
+        )
+    model = ConditionalRBM(**model_parameters(n_components, order, args))
     start = time.process_time()
     model.fit(data["Z_train"], sequence_ids=data["train_ids"])
     fit_time = time.process_time() - start
     start = time.process_time()
     score = model.score(data["Z_test"], sequence_ids=data["test_ids"])
     score_time = time.process_time() - start
+    result = dict(score=score, fit_time=fit_time, score_time=score_time)
+    CACHE.mkdir(parents=True, exist_ok=True)
+    model_path.write_bytes(pickle.dumps(model))
+    result_path.write_text(json.dumps(result, indent=1))
+    return model, result
+
+
+def run_one(data, n_components, order, fold, args):
+    imputer = CRBMImputer(**imputer_parameters(args))
+    leave_out = ("estimator", "random_state", "n_jobs")
+    key = f"{model_key(n_components, order, fold, args)}_fill{_digest(imputer, leave_out)}"
+    path = CACHE / f"{key}.json"
+    if path.exists() and not args.no_cache:
+        return json.loads(path.read_text())
+    model, fitted = fitted_model(data, n_components, order, fold, args)
     result = dict(
         n_components=n_components,
         order=order,
         fold=fold,
-        score=score,
-        fit_time=fit_time,
-        score_time=score_time,
+        **fitted,
         n_test_frames=len(data["Z_test"]),
-        **fillin(model, data, args.seed),
+        **fillin(model, data, args.seed, imputer_parameters(args)),
         generation_error=generation_error(model, data, args.seed),
     )
-    CACHE.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(result, indent=1))
     return result
 
@@ -310,6 +354,12 @@ def main(argv=None):
         default=None,
         help="ConditionalRBM's history_noise (default: the estimator's default)",
     )
+    parser.add_argument(
+        "--paper-fillin",
+        action="store_true",
+        help="fill in with the paper's single chain (n_particles=1, "
+        "offset_shrinkage=None) instead of CRBMImputer's defaults",
+    )
     parser.add_argument("--no-cache", action="store_true", help="refit everything")
     parser.add_argument(
         "--verify-search",
@@ -357,7 +407,8 @@ def main(argv=None):
         ],
         title=(
             f"CMU 35, folds {args.folds}, {args.n_iter} epochs, seed {args.seed}, "
-            f"history_noise {history_noise(args):g}"
+            f"history_noise {history_noise(args):g}, fill-in "
+            f"{'paper (one chain)' if args.paper_fillin else 'CRBMImputer defaults'}"
         ),
     )
     ar_rows = [
@@ -398,7 +449,8 @@ def main(argv=None):
     if args.verify_search:
         summary["search"] = verify_search(args, results)
     write_json(
-        f"model_selection_hn{history_noise(args):g}",
+        f"model_selection_hn{history_noise(args):g}"
+        + ("_paper_fillin" if args.paper_fillin else ""),
         dict(
             args=vars(args),
             results=results,

@@ -205,12 +205,16 @@ fig.savefig(OUTPUT / "model_selection.png", dpi=90)
 # looser.  Here (one fold, 100 epochs, the left leg only) more hidden units
 # fill the leg slightly better while the likelihood prefers fewer.  Over the
 # grid of ``benchmarks/model_selection.py`` (3 folds, both body parts, 16
-# configurations, 500 epochs) the rank correlation between the score and
-# minus the fill-in error among the models with history is 0.80 when they
-# are trained on clean histories (``history_noise=0``) and 0.55 with the
-# default noisy histories, which make larger models fill in better than
-# their clean-history likelihood says; either way the configuration the
-# search picks fills in within 5% of the best of the grid.
+# configurations, 500 epochs, the imputer's defaults) the rank correlation
+# between the score and minus the fill-in error among the models with history
+# is 0.73 when they are trained on clean histories (``history_noise=0``) and
+# 0.08 with the default noisy histories: their hidden units carry the pose
+# and stay uncertain given the past, more so the more of them there are, and
+# the likelihood charges for that spread while the fills, which use the
+# model's mean, do not.  Either way the configuration the search picks fills
+# in within 7% of the best of the grid.  To choose a model for filling in,
+# score the fill-in itself
+# (:func:`~sklearn_crbm.model_selection.make_imputation_scorer`).
 
 # %%
 # A linear-Gaussian autoregressive baseline on the same scale
