@@ -29,7 +29,7 @@ from ._likelihood import (
 )
 from ._online import History, run_online
 from .utils._array_api import array_ops, array_random, is_numpy
-from .utils._parallel import map_sequence_blocks
+from .utils._parallel import SAMPLE_BLOCK, map_sequence_blocks
 from .utils._persistence import VersionedPickleMixin
 from .utils._random import rng_from
 from .utils._sequences import check_sequence_ids
@@ -45,9 +45,6 @@ SCORE_MEAN_FIELD_STEPS = 10
 AIS_STEPS, AIS_CHAINS = 50, 2
 # Draws of the lower layers' hidden units per frame in a stack's bound.
 BOUND_SAMPLES = 10
-# Sequences generated together in one vectorised pass by ``sample``: one
-# frame of 100 sequences costs little more than one of 1, so blocks are large.
-SAMPLE_BLOCK = 256
 # Standard deviation of the jitter added to the previous frame to start the
 # Gibbs chain of a new frame (REFERENCE.md, gen.m).
 START_JITTER = 0.01

@@ -7,6 +7,9 @@ __all__ = ["BLOCK_SEQUENCES", "map_sequence_blocks"]
 
 # Sequences handled together, vectorised, by one job of on-line fill-in.
 BLOCK_SEQUENCES = 32
+# Sequences generated together in one vectorised pass by ``sample``: one
+# frame of 100 sequences costs little more than one of 1, so blocks are large.
+SAMPLE_BLOCK = 256
 
 
 def map_sequence_blocks(

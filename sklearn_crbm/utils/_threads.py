@@ -19,7 +19,7 @@ from threadpoolctl import ThreadpoolController
 
 from .._config import get_config
 from .._crbm_math import CHUNK_FRAMES
-from ._parallel import BLOCK_SEQUENCES
+from ._parallel import BLOCK_SEQUENCES, SAMPLE_BLOCK
 
 __all__ = [
     "MIN_WORK_PER_THREAD",
@@ -164,8 +164,6 @@ def frame_rows(estimator, X, *args, **kwargs):
 
 def sequence_rows(estimator, n_samples, *, history=None, n_sequences=1, **kwargs):
     """Generation: the sequences generated together."""
-    from .._base import SAMPLE_BLOCK  # _base imports this module
-
     if history is not None and np.ndim(history) == 3:
         n_sequences = len(history)
     return min(int(n_sequences), SAMPLE_BLOCK)
