@@ -5,6 +5,8 @@ Tests read the data from ``../shared/data`` beside the repository (or from
 always has it.
 """
 
+import importlib
+import importlib.util
 import os
 from pathlib import Path
 
@@ -55,3 +57,16 @@ def one_blas_thread():
     """One BLAS thread: on small matrices on a busy machine threads only contend."""
     with threadpool_limits(limits=1, user_api="blas"):
         yield
+
+
+# array-api-strict comes with the test extra; PyTorch (CPU build) is installed by
+# .ci/run, being too heavy for the extra.  Tests run on those present.
+OTHER_NAMESPACES = [
+    name for name in ("array_api_strict", "torch") if importlib.util.find_spec(name)
+]
+
+
+@pytest.fixture(params=OTHER_NAMESPACES)
+def other_namespace(request):
+    """An array API namespace other than numpy's, as a module."""
+    return importlib.import_module(request.param)

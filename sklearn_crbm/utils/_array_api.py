@@ -221,16 +221,20 @@ class ArrayOps:
     def std(self, x, axis=None, ddof=0):
         return self.xp.std(x, axis=axis, correction=ddof)
 
+    # numpy.einsum for the contractions the math uses: "ij,ij->i" (row-wise
+    # dot products) and "ij,ij->" (sum of products)
+    _EINSUM_AXES = {"ij,ij->i": 1, "ij,ij->": None}
+
     def einsum(self, subscripts, a, b, dtype=None):
-        """The two row-wise dot products the math uses: ``ij,ij->i`` and ``ij,ij->``."""
+        """``numpy.einsum`` for ``"ij,ij->i"`` and ``"ij,ij->"``."""
+        if subscripts not in self._EINSUM_AXES:
+            raise ValueError(
+                f"ArrayOps.einsum computes {sorted(self._EINSUM_AXES)} only, "
+                f"not {subscripts!r}."
+            )
         if dtype is not None:
             a, b = self.xp.astype(a, dtype), self.xp.astype(b, dtype)
-        product = a * b
-        if subscripts == "ij,ij->i":
-            return self.xp.sum(product, axis=1)
-        if subscripts == "ij,ij->":
-            return self.xp.sum(product)
-        raise NotImplementedError(subscripts)
+        return self.xp.sum(a * b, axis=self._EINSUM_AXES[subscripts])
 
     def finfo(self, dtype):
         return self.xp.finfo(dtype)
