@@ -23,7 +23,14 @@ unless asked (``--seeds``):
   its components, by Gibbs sampling;
 - ``prediction``: the one-step prediction scorer beside the score;
 - ``epochs``: score and fill-in error as training goes on (refits, with
-  ``partial_fit``).
+  ``partial_fit``);
+- ``training``: the grid retrained with the last ``--fraction`` of its
+  epochs changed (``--variant``): ``clean-last`` on clean histories
+  (``history_noise=0``), ``sampled-last`` / ``sampled`` (every epoch) with
+  contrastive divergence whose reconstructions are drawn from ``p(v | h)``,
+  unit-variance noise included, instead of set to their mean (the density
+  the score measures); ``none`` is the main grid.  Score, fill-in error and
+  the spread of ``spread``, per configuration.
 
 ``--paper-fillin`` uses the paper's single-chain fill-in, as in
 ``model_selection.py``.  The findings are in ``benchmarks/README.md``.
@@ -37,6 +44,7 @@ Results are written as JSON to ``benchmarks/results/``.
 """
 
 import argparse
+import contextlib
 import copy
 import json
 import pickle
@@ -50,6 +58,7 @@ from model_selection import (
     _digest,
     _imputer_for,
     fillin,
+    fitted_model,
     imputer_parameters,
     load_fold,
     model_key,
@@ -57,6 +66,7 @@ from model_selection import (
 )
 from scipy.stats import spearmanr
 
+import sklearn_crbm._crbm_math as crbm_math
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm._crbm_math import sequence_dynamic_biases
 from sklearn_crbm._likelihood import FrameRBMs, log_partition
@@ -69,7 +79,11 @@ DIAGNOSTICS = RESULTS / "model_selection_diagnostics"
 
 def _args_for(args, seed=None):
     return argparse.Namespace(
-        **{**vars(args), "seed": args.seed if seed is None else seed}
+        **{
+            **vars(args),
+            "seed": args.seed if seed is None else seed,
+            "no_cache": False,
+        }
     )
 
 
@@ -407,9 +421,7 @@ def other_seeds(args):
     for fold in args.folds:
         data = load_fold(args.data_home, fold)
         for seed in args.seeds:
-            run_args = argparse.Namespace(
-                **{**vars(args), "seed": seed, "no_cache": False}
-            )
+            run_args = _args_for(args, seed)
             for order in args.orders:
                 for size in args.sizes:
                     r = run_one(data, size, order, fold, run_args)
@@ -617,17 +629,7 @@ def spread(args):
     rows = []
     for fold in args.folds:
         data = load_fold(args.data_home, fold)
-        X = data["Z_test"].astype(np.float64)
-        sequences = check_sequence_ids(data["test_ids"], len(X))
-        frames = np.flatnonzero(
-            erasure_mask(
-                X,
-                bones=data["parts"]["left leg"],
-                feature_names=data["names"],
-                sequence_ids=data["test_ids"],
-                strict=False,
-            ).any(axis=1)
-        )
+        X, sequences, frames = _erased_frames(data)
         for order in args.orders:
             for size in args.sizes:
                 model = cached_model(size, order, fold, args)
@@ -701,6 +703,158 @@ def _mixture_moments(params, X, sequences, frames, args):
     return (float(np.concatenate(v).mean()) for v in (error, mix, ar))
 
 
+def _erased_frames(data):
+    """Frames from half-way through every held-out trial (the erased ones)."""
+    X = data["Z_test"].astype(np.float64)
+    mask = erasure_mask(
+        X,
+        bones=data["parts"]["left leg"],
+        feature_names=data["names"],
+        sequence_ids=data["test_ids"],
+        strict=False,
+    )
+    return (
+        X,
+        check_sequence_ids(data["test_ids"], len(X)),
+        np.flatnonzero(mask.any(axis=1)),
+    )
+
+
+# -------------------------------------------------------------------- training
+
+
+@contextlib.contextmanager
+def sampled_reconstructions(seed):
+    """Contrastive divergence with reconstructions drawn from ``p(v | h)``.
+
+    The package's CD sets every reconstruction to its mean (paper, Section
+    2.2), so training never sees the unit-variance noise of the Gaussian
+    visibles that the likelihood integrates over.  Inside this context the
+    reconstructions of ``cd_gradients`` get that noise (a diagnostic: the
+    visible means it patches are those of training only).
+    """
+    mean_of = crbm_math.visible_means
+    rng = np.random.default_rng(seed)
+
+    def drawn(params, hidden, visible_bias, out=None):
+        assert not params.learned_variance and params.visible_type != "binary"
+        mean = mean_of(params, hidden, visible_bias, out=out)
+        mean += rng.standard_normal(mean.shape)
+        return mean
+
+    crbm_math.visible_means = drawn
+    try:
+        yield
+    finally:
+        crbm_math.visible_means = mean_of
+
+
+def _train_variant(data, size, order, fold, args):
+    """A grid cell trained with the last ``--fraction`` of its epochs changed."""
+    if args.variant == "none":
+        return fitted_model(data, size, order, fold, _args_for(args))[0]
+    n_last = (
+        args.n_iter if args.variant == "sampled" else round(args.fraction * args.n_iter)
+    )
+    model = ConditionalRBM(
+        size,
+        order=order,
+        n_iter=args.n_iter - n_last,
+        history_noise=args.history_noise,
+        random_state=args.seed,
+    )
+    X, ids = data["Z_train"], data["train_ids"]
+    changed = (
+        sampled_reconstructions(args.seed + 1000 * fold + size + order)
+        if args.variant.startswith("sampled")
+        else contextlib.nullcontext()
+    )
+    if n_last == args.n_iter:
+        with changed:
+            return model.set_params(n_iter=args.n_iter).fit(X, sequence_ids=ids)
+    model.fit(X, sequence_ids=ids)
+    if args.variant == "clean-last":
+        model.set_params(history_noise=0.0)
+    with changed:
+        while model.n_iter_ < args.n_iter:
+            model.partial_fit(X, sequence_ids=ids)
+    return model
+
+
+def training(args):
+    """Score, fill-in error and spread after changing the end of training."""
+    cache = DIAGNOSTICS / "training_cache"
+    cache.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for fold in args.folds:
+        data = load_fold(args.data_home, fold)
+        X, sequences, frames = _erased_frames(data)
+        for order in args.orders:
+            for size in args.sizes:
+                key = (
+                    f"{args.variant}_fr{args.fraction:g}_{model_key(size, order, fold, args)}"
+                    f"_fill{_digest(CRBMImputer(**imputer_parameters(args)), ('estimator', 'random_state', 'n_jobs'))}"
+                )
+                path = cache / f"{key}.json"
+                if path.exists():
+                    row = json.loads(path.read_text())
+                else:
+                    model = _train_variant(data, size, order, fold, args)
+                    errors = fillin(model, data, args.seed, imputer_parameters(args))
+                    error, mix, _ = _mixture_moments(
+                        model._parameters, X, sequences, frames, args
+                    )
+                    row = dict(
+                        fold=fold,
+                        config=f"{size} x {order}",
+                        order=order,
+                        score=model.score(
+                            data["Z_test"], sequence_ids=data["test_ids"]
+                        ),
+                        error=error,
+                        spread=mix,
+                        leg=errors["left leg"],
+                        upper=errors["upper body"],
+                        fillin=0.5 * (errors["left leg"] + errors["upper body"]),
+                    )
+                    path.write_text(json.dumps(row))
+                rows.append(row)
+                print(
+                    f"{args.variant} fold {fold} {size} x {order}: score "
+                    f"{row['score']:.3f}, spread {row['spread']:.2f}, fill-in "
+                    f"{row['leg']:.3f} / {row['upper']:.3f}",
+                    flush=True,
+                )
+    table = _mean_over_folds(rows)
+    print_table(
+        table,
+        [
+            ("config", "hidden x order", "s"),
+            ("score", "score", ".3f"),
+            ("error", "||x - E[x|past]||^2", ".2f"),
+            ("spread", "E||mu(h) - E[x|past]||^2", ".2f"),
+            ("leg", "fill-in leg", ".3f"),
+            ("upper", "fill-in upper", ".3f"),
+            ("fillin", "fill-in", ".3f"),
+        ],
+        title=f"training variant {args.variant!r}, last {args.fraction:g} of "
+        f"{args.n_iter} epochs, history_noise {args.history_noise:g}",
+    )
+    sub = [r for r in table if r["order"] >= 1]
+    summary = dict(
+        spearman_order_ge_1=spearman(
+            [r["score"] for r in sub], [-r["fillin"] for r in sub]
+        ),
+        mean_fillin=float(np.mean([r["fillin"] for r in sub])),
+        best_fillin=float(min(r["fillin"] for r in sub)),
+    )
+    print(
+        f"order >= 1: Spearman(score, -fill-in) {summary['spearman_order_ge_1']:.3f}; "
+        f"fill-in mean {summary['mean_fillin']:.3f}, best {summary['best_fillin']:.3f}"
+    )
+    return dict(rows=rows, summary=summary)
+
+
 # ------------------------------------------------------------------ prediction
 
 
@@ -761,6 +915,7 @@ def main(argv=None):
             "conditional",
             "spread",
             "prediction",
+            "training",
         ],
     )
     parser.add_argument("--data-home", default=str(DEFAULT_DATA_HOME))
@@ -782,6 +937,12 @@ def main(argv=None):
     parser.add_argument("--exact-max", type=int, default=20)
     parser.add_argument("--seeds", type=int, nargs="+", default=[1, 2])
     parser.add_argument(
+        "--variant",
+        choices=["none", "clean-last", "sampled-last", "sampled"],
+        default="sampled-last",
+    )
+    parser.add_argument("--fraction", type=float, default=0.2)
+    parser.add_argument(
         "--checkpoints", type=int, nargs="+", default=[100, 250, 500, 1000, 2000]
     )
     args = parser.parse_args(argv)
@@ -794,10 +955,12 @@ def main(argv=None):
         conditional=conditional,
         spread=spread,
         prediction=prediction,
+        training=training,
     )[args.what]
     out = run(args)
+    variant = f"_{args.variant}_fr{args.fraction:g}" if args.what == "training" else ""
     write_json(
-        f"model_selection_{args.what}_hn{args.history_noise:g}"
+        f"model_selection_{args.what}{variant}_hn{args.history_noise:g}"
         + ("_paper_fillin" if args.paper_fillin else ""),
         dict(args=vars(args), **out),
         None,
