@@ -288,7 +288,7 @@ def test_input_of_another_namespace_is_a_clear_error(
 
 
 @pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
-@pytest.mark.parametrize("imputer", [AutoregressiveImputer, NearestNeighborImputer])
+@pytest.mark.parametrize("imputer", [AutoregressiveImputer])
 def test_imputers_refuse_other_namespaces_clearly(
     namespace, device_name, dtype_name, imputer, dispatch
 ):
@@ -296,6 +296,32 @@ def test_imputers_refuse_other_namespaces_clearly(
     X, ids = _data(dtype_name)
     with pytest.raises(TypeError, match="fills numpy arrays only"):
         imputer().fit(_to(xp, device, X))
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+def test_nearest_neighbor_imputer_fills_on_the_input_device_as_on_numpy(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids, X_missing = _imputer_data(dtype_name)
+    train = X[ids < 3]
+    with sklearn.config_context(array_api_dispatch=False):
+        expected = NearestNeighborImputer().fit(train).transform(X_missing)
+    imputer = NearestNeighborImputer().fit(_to(xp, device, train))
+    for name in ("_fit_X", "_squared_norms", "mean_"):
+        _same_place(getattr(imputer, name), _to(xp, device, train))
+    X_xp = _to(xp, device, X_missing)
+    filled = imputer.transform(X_xp)
+    _same_place(filled, X_xp)
+    # the same nearest frames: copied values, equal; wholly missing frames
+    # hold the previous frame
+    np.testing.assert_array_equal(_numpy(filled), expected)
+    assert not np.isnan(expected).any()
+    with pytest.raises(ValueError, match="must use the same namespace"):
+        imputer.transform(X_missing)
+    with sklearn.config_context(array_api_dispatch=False):
+        with pytest.raises(TypeError, match="NearestNeighborImputer was fitted on"):
+            imputer.transform(X_missing)
 
 
 def _imputer_data(dtype_name):

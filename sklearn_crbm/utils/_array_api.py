@@ -71,6 +71,7 @@ class ArrayOps:
             "isfinite",
             "all",
             "any",
+            "argmin",
             "min",
             "max",
             "reshape",
