@@ -15,12 +15,12 @@ from ..utils._array_api import array_ops
 from ..utils._sequences import check_sequence_ids
 
 
-def check_imputer_input(imputer, X, *, reset, array_api=False):
+def check_imputer_input(imputer, X, *, reset):
     """Validate ``X`` the way :mod:`sklearn.impute` does.
 
     NaN is allowed when it is the missing-value marker; the returned array is
     a float copy (never the caller's array), so it can be filled in place.
-    ``array_api=True``: ``X`` may be any array API namespace's array (with
+    ``X`` may be any array API namespace's array (with
     ``sklearn.set_config(array_api_dispatch=True)``), and stays in it.
 
     Returns
@@ -30,14 +30,6 @@ def check_imputer_input(imputer, X, *, reset, array_api=False):
         True where ``X`` holds ``missing_values``.
     """
     xp = get_namespace(X)[0]
-    if not (array_api or _is_numpy_namespace(xp)):
-        raise TypeError(
-            f"{type(imputer).__name__} fills numpy arrays only; got {xp.__name__} "
-            "input under sklearn.set_config(array_api_dispatch=True). Pass X as a "
-            "numpy array (e.g. X.cpu().numpy() for a torch tensor); a model trained "
-            "on a GPU moves to numpy with sklearn.utils._array_api."
-            "move_estimator_to(model, numpy, 'cpu')."
-        )
     ensure_all_finite = "allow-nan" if is_scalar_nan(imputer.missing_values) else True
     X = validate_data(
         imputer,

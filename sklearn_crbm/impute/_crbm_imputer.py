@@ -297,7 +297,7 @@ class CRBMImputer(
             The fitted imputer.
         """
         with unfitted_on_error(self):
-            X, mask = check_imputer_input(self, X, reset=True, array_api=True)
+            X, mask = check_imputer_input(self, X, reset=True)
             ops = array_ops(X)
             rows, run_ids = complete_runs(_to_numpy(mask), sequence_ids)
             X = ops.take(X, rows, axis=0)
@@ -395,7 +395,7 @@ class CRBMImputer(
 
     def _impute(self, X, sequence_ids, n_draws, random_state, average):
         check_is_fitted(self)
-        X, mask = check_imputer_input(self, X, reset=False, array_api=True)
+        X, mask = check_imputer_input(self, X, reset=False)
         _check_same_place(self.estimator_, X, "CRBMImputer was fitted with")
         ops = array_ops(X)
         sequences = check_sequence_ids(sequence_ids, X.shape[0])

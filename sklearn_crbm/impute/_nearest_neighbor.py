@@ -114,7 +114,7 @@ class NearestNeighborImputer(
             The fitted imputer.
         """
         with unfitted_on_error(self):
-            X, mask = check_imputer_input(self, X, reset=True, array_api=True)
+            X, mask = check_imputer_input(self, X, reset=True)
             ops = array_ops(X)
             X = ops.take(X, complete_runs(to_numpy(mask), None)[0], axis=0)
             self._fit_X = X
@@ -140,7 +140,7 @@ class NearestNeighborImputer(
         """
         check_is_fitted(self)
         check_same_namespace(X, self, attribute="_fit_X", method="transform")
-        X, mask = check_imputer_input(self, X, reset=False, array_api=True)
+        X, mask = check_imputer_input(self, X, reset=False)
         check_same_place(self._fit_X, X, "NearestNeighborImputer was fitted on")
         ops = array_ops(X)
         mask = to_numpy(mask)
