@@ -375,17 +375,22 @@ def test_crbm_imputer_fills_on_the_input_device_as_on_numpy(
     with sklearn.config_context(array_api_dispatch=False):
         model = ConditionalRBM(6, order=2, n_iter=5, random_state=0)
         model.fit(X, sequence_ids=ids)
-    # mean field alone (no Gibbs sampling, one chain): deterministic
-    imputer, on_device = _moved_imputers(
-        xp, device, X, ids, model, n_gibbs=0, n_particles=1, offset_shrinkage=None
-    )
-    _same_place(on_device.mean_, X_xp)
-    filled = on_device.transform(X_xp)
-    _same_place(filled, X_xp)
-    rtol = 1e-4 if dtype_name == "float32" else 1e-10
-    with sklearn.config_context(array_api_dispatch=False):
-        expected = imputer.transform(X_missing)
-    np.testing.assert_allclose(_numpy(filled), expected, rtol=rtol, atol=rtol)
+    # mean field alone (no Gibbs sampling, one chain): deterministic, also
+    # with the offset correction and the observation gain
+    for inference in (
+        dict(offset_shrinkage=None, observation_gain=1.0),
+        dict(offset_shrinkage=5.0, observation_gain=2.0),
+    ):
+        imputer, on_device = _moved_imputers(
+            xp, device, X, ids, model, n_gibbs=0, n_particles=1, **inference
+        )
+        _same_place(on_device.mean_, X_xp)
+        filled = on_device.transform(X_xp)
+        _same_place(filled, X_xp)
+        rtol = 1e-4 if dtype_name == "float32" else 1e-10
+        with sklearn.config_context(array_api_dispatch=False):
+            expected = imputer.transform(X_missing)
+        np.testing.assert_allclose(_numpy(filled), expected, rtol=rtol, atol=rtol)
     # the defaults (particles, resampling, offsets): observed values untouched,
     # the same fills for the same random_state
     imputer, on_device = _moved_imputers(xp, device, X, ids, model)
