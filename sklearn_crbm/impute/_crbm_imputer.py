@@ -11,7 +11,6 @@ from sklearn.base import (
     clone,
 )
 from sklearn.frozen import FrozenEstimator
-from sklearn.utils._array_api import _convert_to_numpy, get_namespace_and_device
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import HasMethods, Interval, MissingValues
 from sklearn.utils.validation import check_is_fitted
@@ -26,7 +25,8 @@ from ..utils._persistence import VersionedPickleMixin
 from ..utils._random import rng_from
 from ..utils._sequences import Sequences, check_sequence_ids
 from ..utils._threads import chain_rows, limit_blas_threads
-from ._base import check_imputer_input, complete_runs
+from ._base import check_imputer_input, check_same_place, complete_runs
+from ._base import to_numpy as _to_numpy
 
 
 class CRBMImputer(
@@ -335,7 +335,7 @@ class CRBMImputer(
             The fitted imputer.
         """
         with unfitted_on_error(self):
-            X, mask = check_imputer_input(self, X, reset=True, array_api=True)
+            X, mask = check_imputer_input(self, X, reset=True)
             ops = array_ops(X)
             rows, run_ids = complete_runs(_to_numpy(mask), sequence_ids)
             X = ops.take(X, rows, axis=0)
@@ -433,7 +433,7 @@ class CRBMImputer(
 
     def _impute(self, X, sequence_ids, n_draws, random_state, average):
         check_is_fitted(self)
-        X, mask = check_imputer_input(self, X, reset=False, array_api=True)
+        X, mask = check_imputer_input(self, X, reset=False)
         _check_same_place(self.estimator_, X, "CRBMImputer was fitted with")
         ops = array_ops(X)
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
@@ -543,22 +543,9 @@ class CRBMImputer(
         return tags
 
 
-def _to_numpy(array):
-    return _convert_to_numpy(array, get_namespace_and_device(array)[0])
-
-
 def _check_same_place(model, X, what):
     """Refuse ``X`` in another namespace or on another device than ``model``."""
-    if array_ops(model._packed_parameters) is not array_ops(X):
-        model_xp, _, model_device = get_namespace_and_device(model._packed_parameters)
-        xp, _, device = get_namespace_and_device(X)
-        raise TypeError(
-            f"{what} {model_xp.__name__} arrays on {model_device!r}, but X is "
-            f"{xp.__name__} on {device!r}. Pass X in the model's namespace and on "
-            "its device, or move the model first with "
-            "sklearn.utils._array_api.move_estimator_to(model, xp, device) (the "
-            "model, or the fitted imputer)."
-        )
+    check_same_place(model._packed_parameters, X, what)
 
 
 def _check_frozen(model, X):
