@@ -749,6 +749,20 @@ def sampled_reconstructions(seed):
         crbm_math.visible_means = mean_of
 
 
+def _variant_model(data, size, order, fold, args):
+    """The model of ``_train_variant``, pickled in the diagnostics' cache."""
+    path = (
+        DIAGNOSTICS
+        / "training_cache"
+        / f"{args.variant}_fr{args.fraction:g}_{model_key(size, order, fold, args)}.pkl"
+    )
+    if path.exists():
+        return pickle.loads(path.read_bytes())
+    model = _train_variant(data, size, order, fold, args)
+    path.write_bytes(pickle.dumps(model))
+    return model
+
+
 def _train_variant(data, size, order, fold, args):
     """A grid cell trained with the last ``--fraction`` of its epochs changed."""
     if args.variant == "none":
@@ -791,15 +805,19 @@ def training(args):
         X, sequences, frames = _erased_frames(data)
         for order in args.orders:
             for size in args.sizes:
+                fill_digest = _digest(
+                    CRBMImputer(**imputer_parameters(args)),
+                    ("estimator", "random_state", "n_jobs"),
+                )
                 key = (
-                    f"{args.variant}_fr{args.fraction:g}_{model_key(size, order, fold, args)}"
-                    f"_fill{_digest(CRBMImputer(**imputer_parameters(args)), ('estimator', 'random_state', 'n_jobs'))}"
+                    f"{args.variant}_fr{args.fraction:g}_"
+                    f"{model_key(size, order, fold, args)}_fill{fill_digest}"
                 )
                 path = cache / f"{key}.json"
                 if path.exists():
                     row = json.loads(path.read_text())
                 else:
-                    model = _train_variant(data, size, order, fold, args)
+                    model = _variant_model(data, size, order, fold, args)
                     errors = fillin(model, data, args.seed, imputer_parameters(args))
                     error, mix, _ = _mixture_moments(
                         model._parameters, X, sequences, frames, args
