@@ -18,10 +18,11 @@ Protocol (the paper's §4.4, as ``paper_fillin.py``, with a second split):
   ``visible_variance="learned"`` and ``cd_steps=5`` (both with
   ``--ar-history-noise`` if given), ``bare`` ``ConditionalRBM()`` with
   every parameter but ``random_state`` at its default (``--n-iter``
-  ignored); ``transform`` is called once, as a user would.  Each model also fills with the paper's on-line procedure
-  (``--fillins paper``: one chain, no offset correction,
-  ``CRBMImputer(n_particles=1, offset_shrinkage=None)``), the defaults
-  before the offset correction;
+  ignored); ``transform`` is called once, as a user would.  Each model
+  also fills with the paper's on-line procedure (``--fillins paper``: one
+  chain, no offset correction, no observation gain:
+  ``CRBMImputer(n_particles=1, offset_shrinkage=None,
+  observation_gain=1)``), the defaults before the offset correction;
 - error: the paper's (per-frame mean squared error over the erased
   channels, summed over the erased frames, z-scored units).
 
@@ -61,7 +62,10 @@ REPO = Path(__file__).resolve().parents[1]
 PAPER = {"walk/leg": (8.78, 11.68), "walk/upper": (20.52, 22.20)}
 # CRBMImputer settings a model fills with; the rows of "paper" are named
 # "<model>, paper's fill-in".
-FILLINS = {"default": {}, "paper": dict(n_particles=1, offset_shrinkage=None)}
+FILLINS = {
+    "default": {},
+    "paper": dict(n_particles=1, offset_shrinkage=None, observation_gain=1.0),
+}
 
 
 def baselines():

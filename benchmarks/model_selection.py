@@ -35,7 +35,7 @@ on every parameter of the ConditionalRBM and of the CRBMImputer, defaults
 included: a subset (``--sizes 10 50 --orders 1 --folds 0``) can run first
 and the full grid later reuses it, a changed default fits or fills again, and
 ``--paper-fillin`` (the paper's single chain, ``n_particles=1,
-offset_shrinkage=None``) fills the same models without refitting them.
+offset_shrinkage=None, observation_gain=1``) fills the same models without refitting them.
 ``model_selection_diagnostics.py`` reads the cached models.  Run from the
 repository root, with one BLAS thread::
 
@@ -199,7 +199,8 @@ def model_parameters(n_components, order, args):
 
 def imputer_parameters(args):
     """The fill-in procedure: CRBMImputer's defaults, or the paper's single chain."""
-    return dict(n_particles=1, offset_shrinkage=None) if args.paper_fillin else {}
+    paper = dict(n_particles=1, offset_shrinkage=None, observation_gain=1.0)
+    return paper if args.paper_fillin else {}
 
 
 def _digest(estimator, leave_out=()):
@@ -358,7 +359,8 @@ def main(argv=None):
         "--paper-fillin",
         action="store_true",
         help="fill in with the paper's single chain (n_particles=1, "
-        "offset_shrinkage=None) instead of CRBMImputer's defaults",
+        "offset_shrinkage=None, observation_gain=1) instead of CRBMImputer's "
+        "defaults",
     )
     parser.add_argument("--no-cache", action="store_true", help="refit everything")
     parser.add_argument(

@@ -99,7 +99,7 @@ ORIGINAL_MODEL = {
 # The training-side fix: noisy histories (ConditionalRBM's ``history_noise``).
 NOISY_MODEL = dict(ORIGINAL_MODEL, history_noise=0.4)
 # The paper's on-line procedure (CRBMImputer's offset correction off).
-PAPER_FILLIN = dict(n_gibbs=30, offset_shrinkage=None)
+PAPER_FILLIN = dict(n_gibbs=30, offset_shrinkage=None, observation_gain=1.0)
 VARIANTS = {
     "original": dict(model=ORIGINAL_MODEL, imputer=dict(PAPER_FILLIN, n_particles=1)),
     "particles": dict(model=ORIGINAL_MODEL, imputer=dict(PAPER_FILLIN, n_particles=10)),

@@ -24,8 +24,8 @@ from ._crbm_math import (
     CDWorkspace,
     CRBMParameters,
     MomentumUpdate,
+    add_normal_noise,
     cd_gradients,
-    standard_normal,
 )
 from .utils._array_api import array_ops, array_random, to_device_batches
 from .utils._autoregression import ridge_autoregression
@@ -624,11 +624,12 @@ class ConditionalRBM(BaseCRBM):
                     X, batch, n_lags, out=workspace.history[:n, ...]
                 )
                 if self.history_noise:
-                    noise = standard_normal(
-                        math_rng, batch_history.shape, X.dtype, noise_buffer[:n, ...]
+                    add_normal_noise(
+                        math_rng,
+                        batch_history,
+                        self.history_noise,
+                        noise_buffer[:n, ...],
                     )
-                    noise *= self.history_noise
-                    batch_history += noise
                 _, error = cd_gradients(
                     params,
                     visible,

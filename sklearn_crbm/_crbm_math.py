@@ -50,6 +50,18 @@ _FLOAT32_TWO_BITS = np.uint32(0x40000000)
 _MIN_BIT_DRAWS = 4096
 
 
+def _mantissa_floats(rng, size, exponent_bits):
+    """``size`` float32 values in [1, 2) (or [2, 4)) from 23 random bits each.
+
+    Two per 64-bit output of ``rng``'s bit generator, as the mantissa under
+    ``exponent_bits`` (:data:`_FLOAT32_ONE_BITS` or :data:`_FLOAT32_TWO_BITS`).
+    """
+    bits = rng.bit_generator.random_raw((size + 1) // 2).view(np.uint32)[:size]
+    np.right_shift(bits, 9, out=bits)
+    np.bitwise_or(bits, exponent_bits, out=bits)
+    return bits.view(np.float32)
+
+
 def uniform(rng, shape, dtype, out=None, *, symmetric=False):
     """Uniform draws on [0, 1), or on [-1, 1) if ``symmetric``, in ``dtype``.
 
@@ -79,48 +91,72 @@ def uniform(rng, shape, dtype, out=None, *, symmetric=False):
             draws *= 2
             draws -= 1
         return draws
-    bits = rng.bit_generator.random_raw((size + 1) // 2).view(np.uint32)[:size]
-    np.right_shift(bits, 9, out=bits)
-    np.bitwise_or(bits, _FLOAT32_TWO_BITS if symmetric else _FLOAT32_ONE_BITS, out=bits)
-    floats = bits.view(np.float32).reshape(shape)
+    floats = _mantissa_floats(
+        rng, size, _FLOAT32_TWO_BITS if symmetric else _FLOAT32_ONE_BITS
+    ).reshape(shape)
     return np.subtract(floats, 3 if symmetric else 1, out=out)
 
 
 def standard_normal(rng, shape, dtype, out=None):
     """Standard normal draws in ``dtype``.
 
-    float64 draws (and fewer than ``_MIN_BIT_DRAWS`` float32 ones, and any
-    other namespace's) are ``rng.standard_normal``'s.  Larger float32 arrays
-    come from the Box-Muller transform of :func:`uniform`'s 23-bit draws,
-    ``sqrt(-2 log(1 - u)) * (cos, sin)(2 pi u')``: a pair of normals per
-    64 random bits in a few vectorised passes, about four times faster than
-    numpy's float32 ziggurat (which draws one at a time), and the history
-    noise of every training minibatch is that many draws.  Its tails stop at
-    ``sqrt(46 log 2) = 5.65`` standard deviations (probability 2e-8 beyond).
+    Fewer than ``_MIN_BIT_DRAWS`` draws (and any other namespace's) are
+    ``rng.standard_normal``'s.  Larger arrays, float32 or float64, come
+    from the Box-Muller transform, in float32, of 23-bit uniforms ``u, u'``
+    (:func:`uniform`'s), ``sqrt(-2 log(1 - u)) * (cos, sin)(2 pi u')``: a
+    pair of normals per 64 random bits in a few vectorised passes, about
+    five times faster than numpy's ziggurat (which draws one at a time, in
+    either dtype), and the history noise of every training minibatch is
+    that many draws.  float64 draws are these float32 values, converted:
+    plenty for noise.  The tails stop at ``sqrt(46 log 2) =
+    5.65`` standard deviations (probability 2e-8 beyond).
     """
     size = math.prod(shape)
-    if (
-        not isinstance(rng, np.random.Generator)
-        or np.dtype(dtype) != np.float32
-        or size < _MIN_BIT_DRAWS
-    ):
+    if not isinstance(rng, np.random.Generator) or size < _MIN_BIT_DRAWS:
         return rng.standard_normal(shape, dtype=dtype, out=out)
     half = (size + 1) // 2
-    radius, angle = uniform(rng, (2, half), np.float32)
-    np.subtract(1, radius, out=radius)  # (0, 1]: log(0) never taken
+    radius, angle = _mantissa_floats(rng, 2 * half, _FLOAT32_ONE_BITS).reshape(2, half)
+    np.subtract(2, radius, out=radius)  # 1 - u in (0, 1]: log(0) never taken
     np.log(radius, out=radius)
     radius *= -2
     np.sqrt(radius, out=radius)
+    angle -= 1
     angle *= np.float32(2 * np.pi)
-    draws = np.empty((2, half), np.float32)
-    np.cos(angle, out=draws[0])
-    np.sin(angle, out=draws[1])
-    draws *= radius
-    draws = draws.reshape(-1)[:size].reshape(shape)
+    draws = out
+    if out is None or out.dtype != np.float32 or not out.flags.c_contiguous:
+        draws = np.empty(shape, np.float32)
+    # cosines, then sines, each times its radius
+    flat = draws.reshape(-1)
+    np.cos(angle, out=flat[:half])
+    flat[:half] *= radius
+    np.sin(angle[: size - half], out=flat[half:])
+    flat[half:] *= radius[: size - half]
     if out is None:
-        return draws
-    out[...] = draws
+        return draws.astype(dtype, copy=False)
+    if draws is not out:
+        out[...] = draws
     return out
+
+
+def add_normal_noise(rng, array, scale, work=None):
+    """``array += scale * N(0, 1)``, elementwise and in place; returns ``array``.
+
+    The draws are :func:`standard_normal`'s, in float32 where that routine
+    computes them in float32 anyway (at least ``_MIN_BIT_DRAWS`` of them
+    from a numpy Generator), else in ``array``'s dtype.  ``work``, scratch
+    of ``array``'s shape, receives them if it has that dtype.
+    """
+    dtype = array.dtype
+    if isinstance(rng, np.random.Generator) and math.prod(array.shape) >= (
+        _MIN_BIT_DRAWS
+    ):
+        dtype = np.float32
+    if work is not None and work.dtype != dtype:
+        work = None
+    noise = standard_normal(rng, array.shape, dtype, work)
+    noise *= scale
+    array += noise
+    return array
 
 
 def logistic(activation, out=None):
@@ -137,7 +173,7 @@ def logistic(activation, out=None):
     with np.errstate(over="ignore", under="ignore"):
         out = ops.exp(out, out=out)
     out += 1
-    return ops.reciprocal(out, out=out)
+    return ops.divide(1, out, out=out)  # numpy's reciprocal is not vectorised
 
 
 # Learned visible variances are kept at or above 1e-4 (s >= 0.01, in the units
@@ -584,13 +620,19 @@ class HiddenSampler:
     """Draws binary hidden states from p(h | v, history) for fixed dynamic biases.
 
     ``h_j = 1`` where a uniform draw ``u`` falls below ``sigmoid(a_j)``, ``a =
-    v W^T + b_hat``.  The test is evaluated in the form that is fastest for
-    the dtype, each exact up to rounding at the boundary:
+    v W^T + b_hat``.  The test is evaluated in the form that is fastest,
+    each exact up to rounding at the boundary:
 
-    - float32: ``2u - 1 < tanh(a / 2)``, with ``W / 2`` and ``b_hat / 2``
-      prepared once (halving is exact) and ``2u - 1`` drawn directly;
-    - float64: ``u * (1 + exp(-a)) < 1``, with ``-b_hat`` prepared once
-      (numpy's float64 ``tanh`` is slower than ``exp``).
+    - ``2u - 1 < tanh(a / 2)`` in float32, with ``2u - 1`` drawn directly by
+      :func:`uniform` (23 random bits): float32 models, and float64 ones
+      drawing at least ``_MIN_BIT_DRAWS`` states at once (a training
+      minibatch, many chains), whose activations are rounded to float32 for
+      the test only: a probability off by a relative 1e-7 changes a state
+      with about that probability, far below the Monte Carlo noise of the
+      draw itself;
+    - ``u * (1 + exp(-a)) < 1`` in float64 for fewer float64 draws (one
+      sequence: numpy's 53-bit uniforms, the stream of earlier versions),
+      with ``-b_hat`` prepared once.
 
     A Gibbs chain prepares one sampler per frame and calls it at every step.
 
@@ -603,14 +645,23 @@ class HiddenSampler:
 
     def __init__(self, params, hidden_bias):
         self._ops = ops = params.ops
-        self._tanh = params.dtype == ops.float32
-        # a affine map of the activation a: a / 2 (tanh) or -a (exp)
-        self._scale = 0.5 if self._tanh else -1.0
-        self.weights = params.weights * 0.5 if self._tanh else params.weights
+        self._tanh = (
+            params.dtype == ops.float32
+            or math.prod(hidden_bias.shape) >= _MIN_BIT_DRAWS
+        )
+        # the bias in the form the test adds it: b_hat (tanh) or -b_hat (exp)
+        self._scale = 1.0 if self._tanh else -1.0
+        self.weights = params.weights
         std = params.visible_std
         if std is not None:  # the hidden input is W (v / s)
             self.weights = self.weights / std
-        self.bias = ops.multiply(hidden_bias, self._scale, dtype=params.dtype)
+        self.bias = hidden_bias
+        if not self._tanh or hidden_bias.dtype != params.dtype:
+            self.bias = ops.multiply(hidden_bias, self._scale, dtype=params.dtype)
+        # float64 activations are tested in a float32 copy
+        self._threshold = None
+        if self._tanh and params.dtype != ops.float32:
+            self._threshold = ops.empty(hidden_bias.shape, ops.float32)
 
     def __call__(self, visible, rng, out, work, *, hidden_noise=0.0, noise=None):
         """States for ``visible`` (shape ``(n, n_features)``) into ``out``.
@@ -633,10 +684,18 @@ class HiddenSampler:
             bias += self.bias
         activation = ops.matmul(visible, self.weights.T, out=work)
         if self._tanh:
-            activation += bias
-            activation = ops.tanh(activation, out=activation)
-            draws = uniform(rng, activation.shape, ops.float32, out, symmetric=True)
-            return ops.less(draws, activation, out=draws)
+            threshold = activation if self._threshold is None else self._threshold
+            threshold = ops.add(activation, bias, out=threshold)
+            threshold *= 0.5
+            threshold = ops.tanh(threshold, out=threshold)
+            draws = uniform(
+                rng,
+                threshold.shape,
+                ops.float32,
+                out if self._threshold is None else None,
+                symmetric=True,
+            )
+            return ops.less(draws, threshold, out=out)
         activation = ops.subtract(bias, activation, out=activation)
         draws = uniform(rng, activation.shape, activation.dtype, out=out)
         activation = ops.exp(activation, out=activation)

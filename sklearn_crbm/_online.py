@@ -237,14 +237,13 @@ class Offsets:
         self.shrinkage = shrinkage
         self.binary = bottom.visible_type == BINARY
 
-    def update(self, layers, biases, sequences, frames, observed):
-        """Add the residuals of ``frames`` (one per sequence) where ``observed``."""
+    def update(self, prediction, sequences, frames, observed):
+        """Add the residuals of ``frames`` (one per sequence) where ``observed``.
+
+        ``prediction`` is every chain's one-step prediction of the frames
+        (:func:`_one_step_predictions`), of shape ``(n_chains, *frames.shape)``.
+        """
         ops = self._ops
-        n_chains = self.sums.shape[0]
-        prediction = ops.reshape(
-            stacked_prediction(layers, *_split(layers, biases), PREDICTION_STEPS),
-            (n_chains, *frames.shape),
-        )
         self.sums[:, sequences, ...] += ops.where(observed, frames - prediction, 0)
         self.counts[sequences, ...] += ops.astype(observed, self.counts.dtype)
 
@@ -281,6 +280,7 @@ def run_online(
     hidden_noise=0.0,
     sample_visibles=False,
     offset_shrinkage=None,
+    observation_gain=1.0,
 ):
     """Draw frames one after another, each given the chains' own past.
 
@@ -332,6 +332,14 @@ def run_online(
         chain's drawn entries are shifted by the chain's
         :class:`Offsets` correction (its mean one-step residual of that
         channel in that sequence so far, shrunk by ``lam`` frames).
+    observation_gain : float, default=1.0
+        Fill-in only.  The hidden units of a chain see each observed channel
+        at ``x_hat + observation_gain * (x - x_hat)`` instead of at its value
+        ``x``, ``x_hat`` being the chain's one-step prediction of the frame
+        from its past (:func:`_one_step_predictions`): the observed
+        channels' surprise counts ``observation_gain`` times.  The frame
+        keeps the observed values.  ``1``: the model's own conditional.  A
+        sequence's first frame (no past) is filled without it.
 
     Yields
     ------
@@ -433,6 +441,7 @@ def run_online(
             n_particles=n_particles,
             offsets=offsets,
             start_jitter=start_jitter,
+            observation_gain=observation_gain,
         )
         return
     for step in range(n_steps):
@@ -469,17 +478,25 @@ def run_online(
             if offsets is not None:
                 offsets.reorder(chains, sequences[drawn])
         biases = history.biases(sequences)
+        prediction = None
+        if offsets is not None or observation_gain != 1:
+            prediction = _one_step_predictions(layers, biases, frames.shape)
         if offsets is not None and step >= layers[0].n_lags:
-            offsets.update(layers, biases, sequences, frames, ~frame_missing)
+            offsets.update(prediction, sequences, frames, ~frame_missing)
         if len(drawn):
+            seen = frames[drawn]
+            if observation_gain != 1:
+                seen = _amplified(seen, prediction[:, drawn], observation_gain)
             start = np.where(
-                frame_missing[drawn],
-                history.previous(0, sequences[drawn]),
-                frames[drawn],
+                frame_missing[drawn], history.previous(0, sequences[drawn]), seen
             )
             if start_jitter:
                 start += start_jitter * rng.standard_normal(start.shape, start.dtype)
             current[:, drawn] = draw(start, [b[:, drawn] for b in biases], clamp)[0]
+            if observation_gain != 1:
+                current[:, drawn] = np.where(
+                    frame_missing[drawn], current[:, drawn], frames[drawn]
+                )
             if offsets is not None:
                 current[:, drawn] = offsets.corrected(
                     current[:, drawn], sequences[drawn], frame_missing[drawn]
@@ -500,6 +517,7 @@ def _fill_on_device(
     n_particles,
     offsets,
     start_jitter,
+    observation_gain,
 ):
     """The fill-in loop of :func:`run_online` off numpy: every sequence, every step.
 
@@ -543,12 +561,20 @@ def _fill_on_device(
             if offsets is not None:
                 offsets.reorder(chains, every)
         biases = history.biases(every)
+        prediction = None
+        if offsets is not None or observation_gain != 1:
+            prediction = _one_step_predictions(layers, biases, frames.shape)
         if offsets is not None and step >= layers[0].n_lags:
-            offsets.update(layers, biases, every, frames, ~frame_missing)
-        start = ops.where(frame_missing, history.previous(0, every), frames)
+            offsets.update(prediction, every, frames, ~frame_missing)
+        seen = frames
+        if observation_gain != 1:
+            seen = _amplified(frames, prediction, observation_gain)
+        start = ops.where(frame_missing, history.previous(0, every), seen)
         if start_jitter:
             start = start + start_jitter * rng.standard_normal(start.shape, start.dtype)
         current = draw(start, biases, clamp)[0]
+        if observation_gain != 1:
+            current = ops.where(frame_missing, current, frames)
         if offsets is not None:
             current = offsets.corrected(current, every, frame_missing)
         yield step, all_sequences, all_sequences, current
@@ -606,6 +632,28 @@ def _take_chains(ops, array, chains):
     flat = ops.reshape(array, (n_chains * n_sequences, -1))
     index = chains * n_sequences + ops.arange(n_sequences, dtype=ops.int64)
     return ops.reshape(ops.take(flat, ops.reshape(index, (-1,)), axis=0), array.shape)
+
+
+def _one_step_predictions(layers, biases, shape):
+    """Every chain's mean-field prediction of the next frame from its past.
+
+    ``biases`` from :meth:`History.biases` for ``shape[0]`` sequences of
+    ``shape[1]`` features; returns shape ``(n_chains, *shape)``
+    (:func:`~sklearn_crbm._crbm_math.stacked_prediction`).
+    """
+    ops = layers[0].ops
+    prediction = stacked_prediction(layers, *_split(layers, biases), PREDICTION_STEPS)
+    return ops.reshape(prediction, (-1, *shape))
+
+
+def _amplified(frames, prediction, gain):
+    """``prediction + gain * (frames - prediction)``: the surprise, ``gain`` times.
+
+    What the hidden units see of the observed channels with
+    ``observation_gain`` (:func:`run_online`); ``frames`` is broadcast over
+    the chains of ``prediction``.
+    """
+    return prediction + gain * (frames - prediction)
 
 
 def _split(layers, biases):

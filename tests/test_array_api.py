@@ -16,6 +16,7 @@ from functools import partial
 import numpy as np
 import pytest
 import sklearn
+from sklearn.base import clone
 from sklearn.frozen import FrozenEstimator
 from sklearn.utils._array_api import (
     _convert_to_numpy,
@@ -287,17 +288,6 @@ def test_input_of_another_namespace_is_a_clear_error(
         model.score(X, sequence_ids=ids)
 
 
-@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
-@pytest.mark.parametrize("imputer", [AutoregressiveImputer, NearestNeighborImputer])
-def test_imputers_refuse_other_namespaces_clearly(
-    namespace, device_name, dtype_name, imputer, dispatch
-):
-    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
-    X, ids = _data(dtype_name)
-    with pytest.raises(TypeError, match="fills numpy arrays only"):
-        imputer().fit(_to(xp, device, X))
-
-
 def _imputer_data(dtype_name):
     """Training data, and its last sequence with channels and frames missing."""
     X, ids = _data(dtype_name)
@@ -306,6 +296,61 @@ def _imputer_data(dtype_name):
     X_missing[20:24, :] = np.nan  # wholly missing frames
     X_missing[0, 3] = np.nan  # in the first frame
     return X, ids, X_missing
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+@pytest.mark.parametrize(
+    "imputer, fitted",
+    [
+        (NearestNeighborImputer(), ("_fit_X", "_squared_norms", "mean_")),
+        (
+            AutoregressiveImputer(order=2),
+            ("coef_", "intercept_", "covariance_", "mean_", "frame_covariance_"),
+        ),
+        (AutoregressiveImputer(order=0, covariance_type="diag"), ("covariance_",)),
+    ],
+    ids=["nearest", "autoregressive", "autoregressive-diag-order0"],
+)
+def test_baseline_imputers_fill_on_the_input_device_as_on_numpy(
+    namespace, device_name, dtype_name, imputer, fitted, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids, X_missing = _imputer_data(dtype_name)
+    # two test sequences of different lengths
+    X_missing = np.concatenate([X_missing, X_missing[:25]])
+    test_ids = np.repeat([0, 1], [40, 25])
+    X_missing[40, :] = np.nan  # a second sequence that starts wholly missing
+    train = X[ids < 3]
+    # the nearest-neighbour imputer ignores sequences in fit
+    sequences = (
+        {}
+        if isinstance(imputer, NearestNeighborImputer)
+        else {"sequence_ids": ids[ids < 3]}
+    )
+    with sklearn.config_context(array_api_dispatch=False):
+        reference = clone(imputer).fit(train, **sequences)
+        expected = reference.transform(X_missing, sequence_ids=test_ids)
+    train_xp = _to(xp, device, train)
+    on_device = clone(imputer).fit(train_xp, **sequences)
+    rtol = 1e-4 if dtype_name == "float32" else 1e-10
+    for name in fitted:
+        _same_place(getattr(on_device, name), train_xp)
+        np.testing.assert_allclose(
+            _numpy(getattr(on_device, name)),
+            getattr(reference, name),
+            rtol=rtol,
+            atol=rtol,
+        )
+    X_xp = _to(xp, device, X_missing)
+    filled = on_device.transform(X_xp, sequence_ids=test_ids)
+    _same_place(filled, X_xp)
+    assert not np.isnan(expected).any()
+    np.testing.assert_allclose(_numpy(filled), expected, rtol=rtol, atol=rtol)
+    with pytest.raises(ValueError, match="must use the same namespace"):
+        on_device.transform(X_missing)
+    with sklearn.config_context(array_api_dispatch=False):
+        with pytest.raises(TypeError, match="was fitted on"):
+            on_device.transform(X_missing)
 
 
 def _moved_imputers(xp, device, X, ids, model, **params):
@@ -330,17 +375,22 @@ def test_crbm_imputer_fills_on_the_input_device_as_on_numpy(
     with sklearn.config_context(array_api_dispatch=False):
         model = ConditionalRBM(6, order=2, n_iter=5, random_state=0)
         model.fit(X, sequence_ids=ids)
-    # mean field alone (no Gibbs sampling, one chain): deterministic
-    imputer, on_device = _moved_imputers(
-        xp, device, X, ids, model, n_gibbs=0, n_particles=1, offset_shrinkage=None
-    )
-    _same_place(on_device.mean_, X_xp)
-    filled = on_device.transform(X_xp)
-    _same_place(filled, X_xp)
-    rtol = 1e-4 if dtype_name == "float32" else 1e-10
-    with sklearn.config_context(array_api_dispatch=False):
-        expected = imputer.transform(X_missing)
-    np.testing.assert_allclose(_numpy(filled), expected, rtol=rtol, atol=rtol)
+    # mean field alone (no Gibbs sampling, one chain): deterministic, also
+    # with the offset correction and the observation gain
+    for inference in (
+        dict(offset_shrinkage=None, observation_gain=1.0),
+        dict(offset_shrinkage=5.0, observation_gain=2.0),
+    ):
+        imputer, on_device = _moved_imputers(
+            xp, device, X, ids, model, n_gibbs=0, n_particles=1, **inference
+        )
+        _same_place(on_device.mean_, X_xp)
+        filled = on_device.transform(X_xp)
+        _same_place(filled, X_xp)
+        rtol = 1e-4 if dtype_name == "float32" else 1e-10
+        with sklearn.config_context(array_api_dispatch=False):
+            expected = imputer.transform(X_missing)
+        np.testing.assert_allclose(_numpy(filled), expected, rtol=rtol, atol=rtol)
     # the defaults (particles, resampling, offsets): observed values untouched,
     # the same fills for the same random_state
     imputer, on_device = _moved_imputers(xp, device, X, ids, model)

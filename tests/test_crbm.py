@@ -23,7 +23,12 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
 from sklearn_crbm import ConditionalRBM, TrainingDivergedError
-from sklearn_crbm._crbm_math import cd_gradients, hidden_probabilities
+from sklearn_crbm._crbm_math import (
+    cd_gradients,
+    hidden_probabilities,
+    standard_normal,
+    uniform,
+)
 from sklearn_crbm.datasets import load_cmu35, make_oscillations
 from sklearn_crbm.model_selection import make_prediction_scorer
 from sklearn_crbm.utils._random import rng_from
@@ -230,48 +235,68 @@ def test_training_on_crbm_data_raises_exact_likelihood():
 
 
 # ------------------------------------------------------------ CD update
-def test_one_cd1_update_equals_paper_equations():
-    X, ids = make_oscillations(n_sequences=2, n_frames=15, n_features=4, random_state=0)
+@pytest.mark.parametrize(
+    "n_components, n_features, n_frames, history_noise",
+    [
+        (5, 4, 15, 0.0),  # few draws: numpy's float64 uniforms
+        # >= 4096 draws per minibatch: 23-bit uniforms, float32 Box-Muller noise
+        (40, 12, 60, 0.5),
+    ],
+)
+def test_one_cd1_update_equals_paper_equations(
+    n_components, n_features, n_frames, history_noise
+):
+    order = 3
+    X, ids = make_oscillations(
+        n_sequences=2, n_frames=n_frames, n_features=n_features, random_state=0
+    )
     model = ConditionalRBM(
-        5, order=2, batch_size=1000, n_iter=1, history_noise=0.0, random_state=0
+        n_components,
+        order=order,
+        batch_size=1000,
+        n_iter=1,
+        history_noise=history_noise,
+        random_state=0,
     )
     model.partial_fit(X, sequence_ids=ids)  # epoch 1; the update we check is epoch 2
     before = copy.deepcopy(model)
 
     # replay the random stream the second epoch will use
     rng = rng_from(copy.deepcopy(model.random_state_))
-    frames = np.concatenate([np.arange(2, 15), np.arange(17, 30)])
+    frames = np.concatenate(
+        [np.arange(order, n_frames), np.arange(n_frames + order, 2 * n_frames)]
+    )
     (batch,) = balanced_batches(frames, 1000, rng)
-    uniform = rng.random((len(batch), 5))
+    shape = (len(batch), n_components)
+    noise = np.zeros((len(batch), order * n_features))
+    if history_noise:
+        noise = history_noise * standard_normal(rng, noise.shape, np.float32)
+    if len(batch) * n_components >= 4096:  # 2u - 1 from 23 random bits
+        uniform_draws = (uniform(rng, shape, np.float32, symmetric=True) + 1.0) / 2
+    else:
+        uniform_draws = rng.random(shape)
 
     W, A, B = before.components_, before.autoregressive_, before.past_to_hidden_
     b, c = before.intercept_hidden_, before.intercept_visible_
     grad = {k: 0.0 for k in "WbcAB"}
     for row, t in enumerate(batch):
-        v, past = X[t], X[[t - 1, t - 2]]
-        c_hat = c + A[0] @ past[0] + A[1] @ past[1]
-        b_hat = b + B[0] @ past[0] + B[1] @ past[1]
-        h_data = (uniform[row] < expit(b_hat + W @ v)).astype(
-            float
-        )  # binary states (§2.2)
+        # noise on the history only, independent for every lag of every row
+        v = X[t]
+        past = X[[t - q for q in range(1, order + 1)]]
+        past = past + noise[row].reshape(order, n_features)
+        c_hat = c + sum(A[q] @ past[q] for q in range(order))
+        b_hat = b + sum(B[q] @ past[q] for q in range(order))
+        # binary states (§2.2)
+        h_data = (uniform_draws[row] < expit(b_hat + W @ v)).astype(float)
         v_recon = c_hat + W.T @ h_data  # visible mean from binary states
         h_recon = expit(b_hat + W @ v_recon)  # probabilities under the reconstruction
-        grad["W"] = (
-            grad["W"] + np.outer(h_data, v) - np.outer(h_recon, v_recon)
-        )  # Eq. 4
-        grad["b"] = grad["b"] + h_data - h_recon  # Eq. 5
-        grad["c"] = grad["c"] + (v - c_hat) - (v_recon - c_hat)
-        grad["B"] = grad["B"] + np.stack(
-            [np.outer(h_data - h_recon, p) for p in past]
-        )  # Eq. 6
-        grad["A"] = grad["A"] + np.stack(
-            [np.outer(v - v_recon, p) for p in past]
-        )  # Eq. 7
-    n, lr, wd = (
-        len(batch),
-        model.learning_rate,
-        model.weight_decay,
-    )  # momentum is 0 in epoch 2
+        grad["W"] += np.outer(h_data, v) - np.outer(h_recon, v_recon)  # Eq. 4
+        grad["b"] += h_data - h_recon  # Eq. 5
+        grad["c"] += (v - c_hat) - (v_recon - c_hat)
+        grad["B"] += np.stack([np.outer(h_data - h_recon, p) for p in past])  # Eq. 6
+        grad["A"] += np.stack([np.outer(v - v_recon, p) for p in past])  # Eq. 7
+    n, lr, wd = len(batch), model.learning_rate, model.weight_decay
+    # momentum is 0 in epoch 2
     model.partial_fit(X, sequence_ids=ids)
     assert_allclose(model.components_, W + lr * (grad["W"] / n - wd * W), rtol=1e-10)
     assert_allclose(model.intercept_hidden_, b + lr * grad["b"] / n, rtol=1e-10)

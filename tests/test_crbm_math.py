@@ -18,6 +18,7 @@ from sklearn_crbm._crbm_math import (
     CRBMParameters,
     HiddenSampler,
     MomentumUpdate,
+    add_normal_noise,
     cd_gradients,
     dynamic_biases,
     gibbs_frames,
@@ -99,17 +100,16 @@ def test_float32_uniform_draws_are_the_bit_generators_mantissas():
     assert_array_equal(small, np.random.default_rng(4).random((3, 5), np.float32))
 
 
-@pytest.mark.parametrize("shape", [(3, 5), (400, 251)])
-def test_float64_and_small_float32_normal_draws_are_the_generators_own(shape):
-    expected = np.random.default_rng(4).standard_normal(shape)
-    draws = standard_normal(np.random.default_rng(4), shape, np.float64)
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_few_normal_draws_are_the_generators_own(dtype):
+    draws = standard_normal(np.random.default_rng(4), (3, 5), dtype)
+    expected = np.random.default_rng(4).standard_normal((3, 5), dtype)
+    assert draws.dtype == dtype
     assert_array_equal(draws, expected)
-    small = standard_normal(np.random.default_rng(4), (3, 5), np.float32)
-    expected = np.random.default_rng(4).standard_normal((3, 5), np.float32)
-    assert_array_equal(small, expected)
 
 
-def test_float32_normal_draws_are_box_muller_of_the_uniforms():
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_normal_draws_are_box_muller_of_the_uniforms(dtype):
     shape = (400, 251)  # an odd number of draws, enough for the bit route
     size, half = 400 * 251, (400 * 251 + 1) // 2
     u, v = uniform(np.random.default_rng(4), (2, half), np.float32).astype(float)
@@ -117,33 +117,58 @@ def test_float32_normal_draws_are_box_muller_of_the_uniforms():
     expected = np.concatenate(
         [radius * np.cos(2 * np.pi * v), radius * np.sin(2 * np.pi * v)]
     )
-    draws = standard_normal(np.random.default_rng(4), shape, np.float32)
-    assert draws.dtype == np.float32 and draws.shape == shape
+    draws = standard_normal(np.random.default_rng(4), shape, dtype)
+    assert draws.dtype == dtype and draws.shape == shape
     assert_allclose(draws.ravel(), expected[:size], rtol=1e-5, atol=1e-5)
+    # float64 draws are the float32 ones, converted
+    single = standard_normal(np.random.default_rng(4), shape, np.float32)
+    assert_array_equal(draws, single.astype(dtype))
     # standard normal: 10^5 draws pass Kolmogorov-Smirnov, pairs uncorrelated
     assert stats.kstest(draws.ravel().astype(float), "norm").pvalue > 1e-3
+    assert abs(draws.mean()) < 5 / np.sqrt(size)
+    assert draws.var() == pytest.approx(1, abs=5 * np.sqrt(2 / size))
     assert (
         abs(np.corrcoef(draws.ravel()[: half - 1], draws.ravel()[half:-1])[0, 1]) < 0.02
     )
-    out = np.empty(shape, np.float32)
-    assert standard_normal(np.random.default_rng(4), shape, np.float32, out) is out
-    assert_array_equal(out, draws)
+    for out in (np.empty(shape, dtype), np.empty((400, 502), dtype)[:, ::2]):
+        assert standard_normal(np.random.default_rng(4), shape, dtype, out) is out
+        assert_array_equal(out, draws)
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
-def test_hidden_sampler_is_uniform_below_probability(dtype):
+@pytest.mark.parametrize("shape", [(3, 5), (100, 93)])
+def test_add_normal_noise_adds_scaled_standard_normals(dtype, shape):
+    base = np.linspace(-1, 1, shape[0] * shape[1]).reshape(shape).astype(dtype)
+    noisy = base.copy()
+    work = np.empty(shape, dtype)
+    assert add_normal_noise(np.random.default_rng(2), noisy, 0.3, work) is noisy
+    draw_dtype = dtype if shape == (3, 5) else np.float32  # >= 4096: float32
+    draws = standard_normal(np.random.default_rng(2), shape, draw_dtype)
+    assert noisy.dtype == dtype
+    assert_allclose(noisy, base + (0.3 * draws).astype(dtype), rtol=1e-6, atol=1e-7)
+
+
+@pytest.mark.parametrize(
+    "dtype, n, symmetric",
+    [
+        (np.float32, 2000, True),  # 2u - 1 < tanh(a / 2), 23-bit uniforms
+        (np.float32, 10, True),  # numpy's float32 uniforms
+        (np.float64, 2000, True),  # >= 4096 draws: the float32 test
+        (np.float64, 10, False),  # u (1 + exp(-a)) < 1, numpy's float64 uniforms
+    ],
+)
+def test_hidden_sampler_is_uniform_below_probability(dtype, n, symmetric):
     params = make_params(dtype)
-    visible, history = batch(params, n=2000)
+    visible, history = batch(params, n=n)
     _, hidden_bias = dynamic_biases(params, history)
     shape = hidden_bias.shape
     out, work = np.empty(shape, dtype), np.empty(shape, dtype)
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         sampler = HiddenSampler(params, hidden_bias)
         states = sampler(visible, np.random.default_rng(3), out, work)
-    assert states.dtype == dtype
-    # float32 compares 2u - 1 < tanh(a / 2), float64 u (1 + exp(-a)) < 1
-    symmetric = dtype == np.float32
-    draws = uniform(np.random.default_rng(3), states.shape, dtype, symmetric=symmetric)
+    assert states is out and states.dtype == dtype
+    test_dtype = np.float32 if symmetric else np.float64
+    draws = uniform(np.random.default_rng(3), shape, test_dtype, symmetric=symmetric)
     u = (draws.astype(float) + 1) / 2 if symmetric else draws
     p = hidden_probabilities(
         make_params(), visible.astype(float), hidden_bias.astype(float)
@@ -151,9 +176,27 @@ def test_hidden_sampler_is_uniform_below_probability(dtype):
     expected = u < p
     # the forms agree with u < p except within rounding of the boundary
     differ = states != expected
-    assert np.all(np.abs(u - p)[differ] < 10 * np.finfo(dtype).eps)
+    assert np.all(np.abs(u - p)[differ] < 10 * np.finfo(test_dtype).eps)
     assert differ.mean() < 1e-3
     assert set(np.unique(states)) <= {0.0, 1.0}
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_hidden_states_have_their_probabilities_as_frequencies(dtype):
+    # one activation per column, 2000 draws of each: Bernoulli frequencies
+    params = make_params(dtype)
+    params.weights[...] = 0
+    levels = np.array([-6.0, -2.0, -0.5, 0.0, 0.3, 1.0, 4.0])
+    hidden_bias = np.tile(levels, (2000, 1)).astype(dtype)
+    visible = np.zeros((2000, params.n_features), dtype)
+    out, work = np.empty_like(hidden_bias), np.empty_like(hidden_bias)
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        states = HiddenSampler(params, hidden_bias)(
+            visible, np.random.default_rng(8), out, work
+        )
+    p = expit(levels)
+    frequency = states.mean(axis=0)
+    assert np.all(np.abs(frequency - p) < 5 * np.sqrt(p * (1 - p) / 2000) + 1e-3)
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])

@@ -118,6 +118,7 @@ def _imputer_results():
                 n_draws=2,
                 n_particles=particles,
                 offset_shrinkage=None,
+                observation_gain=1.0,
                 random_state=0,
             ).fit(train, sequence_ids=IDS[IDS < 3])
             key = f"particles{particles}.{dtype}"
@@ -155,6 +156,7 @@ def _stacked_results():
             n_gibbs=4,
             n_particles=2,
             offset_shrinkage=None,
+            observation_gain=1.0,
             random_state=0,
         ).fit(X[IDS < 3].astype(dtype), sequence_ids=IDS[IDS < 3])
         out[f"stacked_imputer.transform.{dtype}"] = imputer.transform(X_MISSING)

@@ -113,7 +113,8 @@ def test_samplers_follow_the_conditionals():
     params = tiny_params()
     v, c, b = frame(params)
     # hidden states: u < p(h = 1 | v), with the sampler's own uniform draws
-    n = 2000
+    # (numpy's float64 uniforms: fewer than _MIN_BIT_DRAWS at once)
+    n = 1000
     visible = np.repeat(v[None], n, axis=0)
     hidden_bias = np.repeat(b[None], n, axis=0)
     states = np.empty((n, N_COMPONENTS))

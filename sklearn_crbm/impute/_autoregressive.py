@@ -3,22 +3,23 @@
 from numbers import Integral, Real
 
 import numpy as np
-from scipy import linalg
 from sklearn.base import (
     BaseEstimator,
     OneToOneFeatureMixin,
     TransformerMixin,
     _fit_context,
 )
+from sklearn.utils._array_api import check_same_namespace
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import Interval, MissingValues, StrOptions
 from sklearn.utils.validation import check_is_fitted
 
-from ..utils._autoregression import ridge_autoregression
+from ..utils._array_api import array_ops
+from ..utils._autoregression import ridge_autoregression, solve_positive
 from ..utils._fitting import unfitted_on_error
 from ..utils._persistence import VersionedPickleMixin
-from ..utils._sequences import check_sequence_ids, frame_history
-from ._base import check_imputer_input, complete_runs
+from ..utils._sequences import check_sequence_ids
+from ._base import check_imputer_input, check_same_place, complete_runs, to_numpy
 
 # Added to the diagonal of every covariance: keeps it invertible when a
 # channel is (nearly) a linear function of the others or of the past.
@@ -150,9 +151,10 @@ class AutoregressiveImputer(
         """
         with unfitted_on_error(self):
             X, mask = check_imputer_input(self, X, reset=True)
-            rows, run_ids = complete_runs(mask, sequence_ids)
-            X = X[rows]
-            sequences = check_sequence_ids(run_ids, len(X))
+            ops = array_ops(X)
+            rows, run_ids = complete_runs(to_numpy(mask), sequence_ids)
+            X = ops.take(X, rows, axis=0)
+            sequences = check_sequence_ids(run_ids, X.shape[0])
             frames = sequences.valid_frames(self.order)
             if len(frames) < 2:
                 longest = int(sequences.lengths.max())
@@ -163,10 +165,9 @@ class AutoregressiveImputer(
                     f"their own sequence, but the longest complete sequence has "
                     f"{longest} {noun}. Pass longer sequences or lower order."
                 )
-            self.mean_ = X.mean(axis=0)
-            self.frame_covariance_ = self._regularised(
-                np.cov(X, rowvar=False, bias=True)
-            )
+            self.mean_ = ops.mean(X, axis=0)
+            centred = X - self.mean_
+            self.frame_covariance_ = self._regularised(centred.T @ centred / X.shape[0])
             fit = ridge_autoregression(X, frames, self.order, self.alpha)
             self.intercept_ = fit.intercept
             self.covariance_ = self._regularised(
@@ -176,11 +177,11 @@ class AutoregressiveImputer(
         return self
 
     def _regularised(self, covariance):
-        covariance = np.atleast_2d(covariance)
+        ops = array_ops(covariance)
+        eye = ops.eye(covariance.shape[0], dtype=covariance.dtype)
         if self.covariance_type == "diag":
-            covariance = np.diag(np.diag(covariance))
-        covariance[np.diag_indices_from(covariance)] += _REG_COVAR
-        return covariance
+            covariance = covariance * eye
+        return covariance + _REG_COVAR * eye
 
     def transform(self, X, *, sequence_ids=None):
         """Fill every missing value of ``X`` on-line with its conditional mean.
@@ -199,50 +200,104 @@ class AutoregressiveImputer(
             ``X`` with no missing value left.
         """
         check_is_fitted(self)
+        check_same_namespace(X, self, attribute="coef_", method="transform")
         X, mask = check_imputer_input(self, X, reset=False)
+        check_same_place(self.coef_, X, "AutoregressiveImputer was fitted on")
+        ops = array_ops(X)
+        mask = to_numpy(mask)
+        if not mask.any():
+            return X
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
-        frame_starts = sequences.frame_starts()
+        n_steps, n_features = int(sequences.lengths.max()), X.shape[1]
+        # step-major: frame t of every sequence in one slice; a sequence's
+        # last frame pads it, never written and never read as a past
+        present = np.arange(n_steps)[:, None] < sequences.lengths
+        source = sequences.starts + np.minimum(
+            np.arange(n_steps)[:, None], sequences.lengths - 1
+        )
+        steps = ops.reshape(
+            ops.take(X, source.ravel(), axis=0), (*source.shape, n_features)
+        )
+        step_masks = mask[source] & present[..., None]
+        # the prediction from the past: history @ weights, lag-major history
+        weights = ops.reshape(self._lag_weights(), (-1, n_features))
         gains = {}
-        for step in range(int(sequences.lengths.max(initial=0))):
-            rows = sequences.starts[sequences.lengths > step] + step
-            rows = rows[mask[rows].any(axis=1)]
-            if not len(rows):
+        for step in range(n_steps):
+            if not step_masks[step].any():
                 continue
             marginal = step == 0 or self.order == 0
             if marginal:
-                mean = np.broadcast_to(self.mean_, (len(rows), X.shape[1]))
+                mean = ops.broadcast_to(self.mean_, steps.shape[1:])
                 covariance = self.frame_covariance_
             else:
-                history = frame_history(X, rows, self.order, frame_starts[rows])
-                mean = history @ self.coef_.transpose(0, 2, 1).reshape(-1, X.shape[1])
-                mean += self.intercept_
-                covariance = self.covariance_
-            self._fill_conditional(X, mask, rows, mean, covariance, gains, marginal)
-        return X
-
-    @staticmethod
-    def _fill_conditional(X, mask, rows, mean, covariance, gains, marginal):
-        """Each row's ``x_m = mu_m + S_mo S_oo^{-1} (x_o - mu_o)``, by mask pattern."""
-        patterns, which = np.unique(mask[rows], axis=0, return_inverse=True)
-        for k, missing in enumerate(patterns):
-            chosen = which.ravel() == k
-            sub = rows[chosen]
-            observed = ~missing
-            key = (marginal, missing.tobytes())
-            if key not in gains:
-                gains[key] = (
-                    linalg.solve(
-                        covariance[np.ix_(observed, observed)],
-                        covariance[np.ix_(observed, missing)],
-                        assume_a="pos",
-                    ).T
-                    if observed.any()
-                    else np.zeros((missing.sum(), 0))
+                history = ops.concatenate(
+                    [steps[max(step - q, 0), ...] for q in range(1, self.order + 1)],
+                    axis=1,
                 )
-            residual = X[np.ix_(sub, observed)] - mean[chosen][:, observed]
-            X[np.ix_(sub, missing)] = mean[chosen][:, missing] + residual @ gains[key].T
+                mean = history @ weights + self.intercept_
+                covariance = self.covariance_
+            steps[step, ...] = _fill_conditional(
+                steps[step, ...], step_masks[step], mean, covariance, gains, marginal
+            )
+        # back to the rows of X: frame t of sequence s is row t * n_sequences + s
+        in_order = np.argsort(sequences.starts)
+        sequence = np.repeat(in_order, sequences.lengths[in_order])
+        step = np.arange(X.shape[0]) - sequences.starts[sequence]
+        position = step * len(sequences.starts) + sequence
+        return ops.take(ops.reshape(steps, (-1, n_features)), position, axis=0)
+
+    def _lag_weights(self):
+        """``coef_`` as ``(order, n_features, n_features)`` acting on row vectors."""
+        if isinstance(self.coef_, np.ndarray):
+            return self.coef_.transpose(0, 2, 1)
+        return array_ops(self.coef_).permute_dims(self.coef_, (0, 2, 1))
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
         tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
+        tags.array_api_support = True
         return tags
+
+
+def _fill_conditional(frames, mask, mean, covariance, gains, marginal):
+    """Each row's ``x_m = mu_m + S_mo S_oo^{-1} (x_o - mu_o)``, by mask pattern.
+
+    ``frames`` (shape ``(n, n_features)``, missing entries NaN) is filled
+    where ``mask`` (numpy bool) is True; a new array is returned.  Each
+    pattern's gain is kept in ``gains`` as a full ``(n_features,
+    n_features)`` matrix, zero outside the (missing, observed) block, so
+    that all rows go through one product and the pattern's own are kept.
+    """
+    ops = array_ops(frames)
+    rows = np.flatnonzero(mask.any(axis=1))
+    patterns, which = np.unique(mask[rows], axis=0, return_inverse=True)
+    residual = frames - mean
+    for k, missing in enumerate(patterns):
+        key = (marginal, missing.tobytes())
+        if key not in gains:
+            gains[key] = _full_gain(covariance, missing)
+        observed = ops.asarray(~missing)
+        values = ops.where(observed, residual, 0.0) @ gains[key].T + mean
+        chosen = np.zeros_like(mask)
+        chosen[rows[which.ravel() == k]] = missing
+        frames = ops.where(ops.asarray(chosen), values, frames)
+    return frames
+
+
+def _full_gain(covariance, missing):
+    """``S_mo S_oo^{-1}`` placed in a ``(n_features, n_features)`` zero matrix."""
+    ops = array_ops(covariance)
+    n_features = covariance.shape[0]
+    observed, missing = np.flatnonzero(~missing), np.flatnonzero(missing)
+    if not len(observed):
+        return ops.zeros((n_features, n_features), dtype=covariance.dtype)
+    block = ops.take(covariance, observed, axis=0)
+    gain = solve_positive(
+        ops.take(block, observed, axis=1), ops.take(block, missing, axis=1)
+    ).T
+    # one-hot rows that put the block's rows and columns at these indices
+    place_missing, place_observed = (
+        ops.asarray(np.eye(n_features)[indices], dtype=covariance.dtype)
+        for indices in (missing, observed)
+    )
+    return place_missing.T @ gain @ place_observed

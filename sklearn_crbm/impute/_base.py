@@ -1,20 +1,26 @@
 """What both imputers share: input checks and the missing-value mask."""
 
 import numpy as np
-from sklearn.utils._array_api import _is_numpy_namespace, get_namespace
+from sklearn.utils._array_api import (
+    _convert_to_numpy,
+    _is_numpy_namespace,
+    get_namespace,
+    get_namespace_and_device,
+)
 from sklearn.utils._mask import _get_mask
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils.validation import FLOAT_DTYPES, validate_data
 
+from ..utils._array_api import array_ops
 from ..utils._sequences import check_sequence_ids
 
 
-def check_imputer_input(imputer, X, *, reset, array_api=False):
+def check_imputer_input(imputer, X, *, reset):
     """Validate ``X`` the way :mod:`sklearn.impute` does.
 
     NaN is allowed when it is the missing-value marker; the returned array is
     a float copy (never the caller's array), so it can be filled in place.
-    ``array_api=True``: ``X`` may be any array API namespace's array (with
+    ``X`` may be any array API namespace's array (with
     ``sklearn.set_config(array_api_dispatch=True)``), and stays in it.
 
     Returns
@@ -24,14 +30,6 @@ def check_imputer_input(imputer, X, *, reset, array_api=False):
         True where ``X`` holds ``missing_values``.
     """
     xp = get_namespace(X)[0]
-    if not (array_api or _is_numpy_namespace(xp)):
-        raise TypeError(
-            f"{type(imputer).__name__} fills numpy arrays only; got {xp.__name__} "
-            "input under sklearn.set_config(array_api_dispatch=True). Pass X as a "
-            "numpy array (e.g. X.cpu().numpy() for a torch tensor); a model trained "
-            "on a GPU moves to numpy with sklearn.utils._array_api."
-            "move_estimator_to(model, numpy, 'cpu')."
-        )
     ensure_all_finite = "allow-nan" if is_scalar_nan(imputer.missing_values) else True
     X = validate_data(
         imputer,
@@ -75,3 +73,22 @@ def complete_runs(mask, sequence_ids):
     run_ids = np.cumsum(new_run) - 1
     rows = np.flatnonzero(complete)
     return rows, run_ids[rows]
+
+
+def to_numpy(array):
+    """``array`` as a numpy array (a copy off the host)."""
+    return _convert_to_numpy(array, get_namespace_and_device(array)[0])
+
+
+def check_same_place(fitted, X, what):
+    """Refuse ``X`` in another namespace or on another device than ``fitted``."""
+    if array_ops(fitted) is not array_ops(X):
+        fitted_xp, _, fitted_device = get_namespace_and_device(fitted)
+        xp, _, device = get_namespace_and_device(X)
+        raise TypeError(
+            f"{what} {fitted_xp.__name__} arrays on {fitted_device!r}, but X is "
+            f"{xp.__name__} on {device!r}. Pass X in the model's namespace and on "
+            "its device, or move the model first with "
+            "sklearn.utils._array_api.move_estimator_to(model, xp, device) (the "
+            "model, or the fitted imputer)."
+        )

@@ -7,14 +7,16 @@ from sklearn.base import (
     TransformerMixin,
     _fit_context,
 )
+from sklearn.utils._array_api import check_same_namespace
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import MissingValues
 from sklearn.utils.validation import check_is_fitted
 
+from ..utils._array_api import array_ops
 from ..utils._fitting import unfitted_on_error
 from ..utils._persistence import VersionedPickleMixin
 from ..utils._sequences import check_sequence_ids
-from ._base import check_imputer_input, complete_runs
+from ._base import check_imputer_input, check_same_place, complete_runs, to_numpy
 
 # Distances computed at once: bounds memory to about 32 MB of float64.
 _MAX_DISTANCES = 1 << 22
@@ -64,6 +66,13 @@ class NearestNeighborImputer(
     frames.  Only wholly missing frames depend on ``sequence_ids``.  Ties
     between equally close training frames go to the earliest one.
 
+    *Array API.*  With ``sklearn.set_config(array_api_dispatch=True)``,
+    ``fit`` and ``transform`` take the arrays of any array API namespace
+    (PyTorch, CuPy, ...) and compute the distances on their device; the
+    fitted attributes live there too, and ``transform`` wants ``X`` in the
+    namespace and on the device it was fitted on.  Only the missing-value
+    pattern and the index of each nearest frame pass through the host.
+
     References
     ----------
     G. W. Taylor, G. E. Hinton and S. Roweis. Modeling Human Motion Using
@@ -106,15 +115,11 @@ class NearestNeighborImputer(
         """
         with unfitted_on_error(self):
             X, mask = check_imputer_input(self, X, reset=True)
-            X = X[complete_runs(mask, None)[0]]
-            if len(X) == 0:
-                raise ValueError(
-                    "NearestNeighborImputer needs complete training frames, but "
-                    "every frame of X has a missing value. Fit on complete data."
-                )
+            ops = array_ops(X)
+            X = ops.take(X, complete_runs(to_numpy(mask), None)[0], axis=0)
             self._fit_X = X
-            self._squared_norms = np.einsum("ij,ij->i", X, X)
-            self.mean_ = X.mean(axis=0)
+            self._squared_norms = ops.einsum("ij,ij->i", X, X)
+            self.mean_ = ops.mean(X, axis=0)
         return self
 
     def transform(self, X, *, sequence_ids=None):
@@ -134,39 +139,52 @@ class NearestNeighborImputer(
             ``X`` with no missing value left.
         """
         check_is_fitted(self)
+        check_same_namespace(X, self, attribute="_fit_X", method="transform")
         X, mask = check_imputer_input(self, X, reset=False)
+        check_same_place(self._fit_X, X, "NearestNeighborImputer was fitted on")
+        ops = array_ops(X)
+        mask = to_numpy(mask)
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
         empty = mask.all(axis=1)
         partial = np.flatnonzero(mask.any(axis=1) & ~empty)
         if len(partial):
+            # every partial frame's nearest training frame, then one fill
+            nearest = np.zeros(X.shape[0], dtype=np.int64)
             patterns, which = np.unique(mask[partial], axis=0, return_inverse=True)
             groups = _split(partial, which.ravel())
             for pattern, rows in zip(patterns, groups, strict=True):
-                self._fill_pattern(X, rows, pattern)
+                nearest[rows] = self._nearest(X, rows, pattern)
+            fill = ops.take(self._fit_X, nearest, axis=0)
+            in_partial = np.zeros(X.shape[0], dtype=bool)
+            in_partial[partial] = True
+            X = ops.where(ops.asarray(mask & in_partial[:, None]), fill, X)
         if empty.any():
-            _hold_previous(X, empty, sequences.frame_starts(), self.mean_)
+            X = _hold_previous(X, empty, sequences.frame_starts(), self.mean_)
         return X
 
-    def _fill_pattern(self, X, rows, missing):
-        """Fill ``X[rows]``, which all miss exactly the columns ``missing``."""
-        observed = ~missing
-        train = self._fit_X[:, observed]
+    def _nearest(self, X, rows, missing):
+        """The nearest training frame of each of ``X[rows]``, which miss ``missing``."""
+        ops = array_ops(X)
+        observed, missing = np.flatnonzero(~missing), np.flatnonzero(missing)
+        train = ops.take(self._fit_X, observed, axis=1)
         # ||x - t||^2 = ||x||^2 - 2 x.t + ||t||^2; ||x||^2 does not change argmin.
-        train_norms = self._squared_norms - np.einsum(
-            "ij,ij->i", self._fit_X[:, missing], self._fit_X[:, missing]
-        )
-        step = max(1, _MAX_DISTANCES // len(train))
+        dropped = ops.take(self._fit_X, missing, axis=1)
+        train_norms = self._squared_norms - ops.einsum("ij,ij->i", dropped, dropped)
+        step = max(1, _MAX_DISTANCES // train.shape[0])
+        nearest = []
         for lo in range(0, len(rows), step):
-            chunk = rows[lo : lo + step]
-            distances = X[np.ix_(chunk, observed)] @ train.T
+            queries = ops.take(X, rows[lo : lo + step], axis=0)
+            queries = ops.take(queries, observed, axis=1)
+            distances = ops.matmul(queries, train.T)
             distances *= -2
             distances += train_norms
-            nearest = np.argmin(distances, axis=1)
-            X[np.ix_(chunk, missing)] = self._fit_X[np.ix_(nearest, missing)]
+            nearest.append(to_numpy(ops.argmin(distances, axis=1)))
+        return np.concatenate(nearest)
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
         tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
+        tags.array_api_support = True
         return tags
 
 
@@ -182,12 +200,14 @@ def _hold_previous(X, empty, frame_starts, fallback):
 
     ``X`` must already be filled everywhere else.  A wholly missing frame
     with no other frame before it in its sequence takes ``fallback``.
+    Returns the filled ``X`` (a new array), in its namespace.
     """
-    index = np.arange(len(X))
+    index = np.arange(len(empty))
     last_filled = np.maximum.accumulate(np.where(empty, -1, index))
     source = np.where(last_filled >= frame_starts, last_filled, -1)
-    rows = np.flatnonzero(empty)
-    source = source[rows]
-    has_source = source >= 0
-    X[rows[has_source]] = X[source[has_source]]
-    X[rows[~has_source]] = fallback
+    # every frame's source row: itself, the frame it holds, or the fallback
+    source = np.where(empty, source, index)
+    source[source < 0] = len(empty)
+    ops = array_ops(X)
+    rows = ops.concatenate((X, ops.reshape(fallback, (1, -1))))
+    return ops.take(rows, source, axis=0)

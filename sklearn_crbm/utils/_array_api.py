@@ -71,6 +71,7 @@ class ArrayOps:
             "isfinite",
             "all",
             "any",
+            "argmin",
             "min",
             "max",
             "reshape",
@@ -111,6 +112,9 @@ class ArrayOps:
 
     def ones(self, shape, dtype=None):
         return self.xp.ones(shape, dtype=dtype, device=self.device)
+
+    def eye(self, n, dtype=None):
+        return self.xp.eye(n, dtype=dtype, device=self.device)
 
     def full(self, shape, value, dtype=None):
         return self.xp.full(shape, value, dtype=dtype, device=self.device)

@@ -4,9 +4,10 @@ import numpy as np
 from scipy import linalg
 from sklearn.utils import Bunch
 
+from ._array_api import array_ops
 from ._sequences import frame_history
 
-__all__ = ["ridge_autoregression"]
+__all__ = ["ridge_autoregression", "solve_positive"]
 
 
 def ridge_autoregression(X, frames, order, alpha):
@@ -15,7 +16,8 @@ def ridge_autoregression(X, frames, order, alpha):
     Parameters
     ----------
     X : ndarray of shape (n_frames, n_features)
-        Sequences stacked, each contiguous and in time order.
+        Sequences stacked, each contiguous and in time order; any array API
+        namespace's array (the results are in it).
     frames : ndarray of int
         The frames regressed on their past; each must have ``order`` past
         frames in its own sequence.
@@ -44,21 +46,36 @@ def ridge_autoregression(X, frames, order, alpha):
     [1.] [1.] True
     """
     n_features = X.shape[1]
-    target = X[frames]
+    ops = array_ops(X)
+    target = ops.take(X, frames, axis=0)
     history = frame_history(X, frames, order)
-    history_mean = history.mean(axis=0)
+    history_mean = ops.mean(history, axis=0)
     centred = history - history_mean
     gram = centred.T @ centred
-    gram[np.diag_indices_from(gram)] += alpha
+    gram += alpha * ops.eye(gram.shape[0], dtype=gram.dtype)
+    target_mean = ops.mean(target, axis=0)
     weights = (
-        linalg.solve(gram, centred.T @ (target - target.mean(axis=0)), assume_a="pos")
+        solve_positive(gram, centred.T @ (target - target_mean))
         if order
-        else np.zeros((0, n_features))
+        else ops.zeros((0, n_features), dtype=X.dtype)
     )
-    intercept = target.mean(axis=0) - history_mean @ weights
-    coef = weights.T.reshape(n_features, order, n_features).transpose(1, 0, 2)
+    intercept = target_mean - history_mean @ weights
+    coef = ops.reshape(weights.T, (n_features, order, n_features))
+    # numpy < 2 has no permute_dims
+    coef = coef.transpose(1, 0, 2) if ops is np else ops.permute_dims(coef, (1, 0, 2))
     return Bunch(
-        coef=np.ascontiguousarray(coef),
+        coef=ops.ascontiguousarray(coef),
         intercept=intercept,
         residual=target - history @ weights - intercept,
     )
+
+
+def solve_positive(a, b):
+    """``a^{-1} b`` for a symmetric positive definite ``a``, in its namespace.
+
+    scipy's Cholesky-based solver on numpy; the namespace's
+    ``linalg.solve`` elsewhere.
+    """
+    if isinstance(a, np.ndarray):
+        return linalg.solve(a, b, assume_a="pos")
+    return array_ops(a).xp.linalg.solve(a, b)

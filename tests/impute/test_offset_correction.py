@@ -1,4 +1,5 @@
-"""CRBMImputer's offset correction (``offset_shrinkage``), against a loop written out."""
+"""CRBMImputer's offset correction (``offset_shrinkage``) and observation gain
+(``observation_gain``), against a loop written out."""
 
 import numpy as np
 import pytest
@@ -29,16 +30,18 @@ def _sigmoid(a):
     return 1 / (1 + np.exp(-a))
 
 
-def reference_fill(model, X_missing, shrinkage):
+def reference_fill(model, X_missing, shrinkage, gain=1.0):
     """The corrected on-line fill with ``n_gibbs=0`` and one chain, written out.
 
     Frame ``t`` (past ``x[t-1], x[t-2]``, the fills where missing): dynamic
     biases ``b = b0 + sum_q A_q x[t-q]`` and ``c = c0 + sum_q B_q x[t-q]``;
     prediction ``v <- b + W^T sigmoid(c + W v)`` ten times from ``v = b``;
     the residual ``x_t - v`` of each observed channel is summed (frames from
-    the order on).  A missing channel starts at its previous value, gets one
+    the order on).  A missing channel starts at its previous value, an
+    observed one at ``v + gain * (x_t - v)``; the missing channels get one
     mean-field step ``b + W^T sigmoid(c + W start)``, plus ``sum / (n +
-    shrinkage)``.  The first frames must be complete.
+    shrinkage)`` unless ``shrinkage`` is None.  The first frames must be
+    complete.
     """
     W = model.components_
     A = model.autoregressive_
@@ -58,9 +61,10 @@ def reference_fill(model, X_missing, shrinkage):
         sums[seen] += x[t, seen] - v[seen]
         counts[seen] += 1
         if missing[t].any():
-            start = np.where(missing[t], x[t - 1], x[t])
+            start = np.where(missing[t], x[t - 1], v + gain * (x[t] - v))
             fill = b + W.T @ _sigmoid(c + W @ start)
-            fill += sums / np.maximum(counts + shrinkage, 1)
+            if shrinkage is not None:
+                fill += sums / np.maximum(counts + shrinkage, 1)
             x[t] = np.where(missing[t], fill, x[t])
     return x
 
@@ -71,13 +75,64 @@ def test_matches_the_loop_written_out(model, data):
     X_missing[8:, 1] = np.nan
     X_missing[12:16, 2] = np.nan  # a gap: its residuals resume after it
     imputer = CRBMImputer(
-        FrozenEstimator(model), n_gibbs=0, n_particles=1, offset_shrinkage=2.5
+        FrozenEstimator(model),
+        n_gibbs=0,
+        n_particles=1,
+        offset_shrinkage=2.5,
+        observation_gain=1.0,
     ).fit(X)
     expected = reference_fill(model, X_missing, 2.5)
     assert_allclose(imputer.transform(X_missing), expected, rtol=1e-10, atol=1e-12)
     # and the correction does something: without it the fills differ
     plain = imputer.set_params(offset_shrinkage=None).transform(X_missing)
     assert np.abs(plain - expected)[8:, 1].max() > 1e-3
+
+
+@pytest.mark.parametrize("shrinkage", [None, 2.5])
+@pytest.mark.parametrize("gain", [0.0, 3.0])
+def test_observation_gain_matches_the_loop_written_out(model, data, shrinkage, gain):
+    X, ids = data
+    X_missing = X[ids == 2].copy()
+    X_missing[10:, 0] = np.nan
+    X_missing[14:20, 2] = np.nan
+    imputer = CRBMImputer(
+        FrozenEstimator(model),
+        n_gibbs=0,
+        n_particles=1,
+        offset_shrinkage=shrinkage,
+        observation_gain=gain,
+    ).fit(X)
+    expected = reference_fill(model, X_missing, shrinkage, gain)
+    filled = imputer.transform(X_missing)
+    assert_allclose(filled, expected, rtol=1e-10, atol=1e-12)
+    observed = ~np.isnan(X_missing)
+    assert_array_equal(filled[observed], X_missing[observed])
+    # the gain does something: with 1 the fills differ
+    plain = imputer.set_params(observation_gain=1.0).transform(X_missing)
+    assert_allclose(plain, reference_fill(model, X_missing, shrinkage), rtol=1e-10)
+    assert np.abs(plain - expected)[10:, 0].max() > 1e-6  # a weak model: small
+
+
+def test_gain_zero_ignores_the_frame_s_observed_values(model, data):
+    """With gain 0 the hidden units see the prediction, not the observation."""
+    X, ids = data
+    X_missing = X[ids == 3].copy()
+    X_missing[20:, 0] = np.nan
+    X_moved = X_missing.copy()
+    X_moved[25, 1:] += 2.0  # the observed channels of frame 25 only
+    imputer = CRBMImputer(
+        FrozenEstimator(model),
+        n_particles=4,
+        offset_shrinkage=None,
+        observation_gain=0.0,
+        random_state=0,
+    ).fit(X)
+    filled, moved = imputer.transform(X_missing), imputer.transform(X_moved)
+    assert_array_equal(moved[:26, 0], filled[:26, 0])
+    assert np.abs(moved[26:, 0] - filled[26:, 0]).max() > 1e-3  # the past moved
+    # with gain 1 they are seen
+    imputer.set_params(observation_gain=1.0)
+    assert imputer.transform(X_moved)[25, 0] != imputer.transform(X_missing)[25, 0]
 
 
 def test_infinite_shrinkage_is_no_correction(model, data):
@@ -127,10 +182,11 @@ def test_complete_frames_and_observed_values_are_untouched(model, data):
     assert np.isfinite(filled).all()
 
 
-def test_negative_shrinkage_is_rejected(data):
+@pytest.mark.parametrize("name", ["offset_shrinkage", "observation_gain"])
+def test_negative_shrinkage_and_gain_are_rejected(data, name):
     X, _ = data
-    imputer = CRBMImputer(ConditionalRBM(3, n_iter=1), offset_shrinkage=-1)
-    with pytest.raises(InvalidParameterError, match="offset_shrinkage"):
+    imputer = CRBMImputer(ConditionalRBM(3, n_iter=1), **{name: -1})
+    with pytest.raises(InvalidParameterError, match=name):
         imputer.fit(X)
 
 

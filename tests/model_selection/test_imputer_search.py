@@ -51,7 +51,12 @@ def _crbm_imputer(**params):
         16, order=2, n_iter=30, batch_size=50, history_noise=0.0, random_state=0
     )
     imputer = CRBMImputer(
-        model, n_gibbs=5, n_particles=1, offset_shrinkage=None, random_state=0
+        model,
+        n_gibbs=5,
+        n_particles=1,
+        offset_shrinkage=None,
+        observation_gain=1.0,
+        random_state=0,
     )
     return imputer.set_params(**params)
 
