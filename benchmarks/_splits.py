@@ -74,7 +74,8 @@ class Split:
 
 
 # What a trained model depends on: the cache key leaves out parameters that
-# only affect inference (and any added later), so later code reuses the fits.
+# only affect inference (and any added later), so changes to inference reuse
+# the fits.
 _TRAINING_PARAMETERS = (
     "n_components order hidden_order visible_type visible_variance learning_rate "
     "momentum momentum_delay weight_decay cd_steps batch_size batching "
@@ -85,6 +86,22 @@ _TRAINING_PARAMETERS = (
 # Training parameters added later, with the value the fits cached before had:
 # in the key only when they differ from it.
 _LATER_PARAMETERS = {"init": "random"}
+
+# The code a fit runs: a change to any of these (e.g. a new random stream)
+# changes the fitted models, so their text is part of the key too.
+_TRAINING_CODE = [
+    Path(__file__).resolve().parents[1] / "sklearn_crbm" / name
+    for name in (
+        "_base.py",
+        "_crbm.py",
+        "_crbm_math.py",
+        "utils/_array_api.py",
+        "utils/_autoregression.py",
+        "utils/_random.py",
+        "utils/_sequences.py",
+        "utils/_windows.py",
+    )
+]
 
 
 def cached_model(cache_dir, model, X, sequence_ids):
@@ -98,6 +115,8 @@ def cached_model(cache_dir, model, X, sequence_ids):
     digest = hashlib.sha1(repr(sorted(params.items())).encode())
     digest.update(np.ascontiguousarray(X).tobytes())
     digest.update(np.ascontiguousarray(sequence_ids).tobytes())
+    for source in _TRAINING_CODE:
+        digest.update(source.read_bytes())
     path = Path(cache_dir) / f"{type(model).__name__}_{digest.hexdigest()[:20]}.joblib"
     if path.exists():
         return joblib.load(path)

@@ -99,8 +99,8 @@ class CRBMImputer(
         ``observation_gain`` times.  ``1`` is the model's own conditional
         (with ``n_particles=1`` and ``offset_shrinkage=None``, the paper's
         fill-in exactly); ``0`` ignores the frame's observed values
-        (a pure prediction from the past).  ``2`` was the best of 1, 1.5,
-        2, 2.5 and 3 on the training trials of CMU subject 35.
+        (a pure prediction from the past).  ``2`` suits CMU subject 35
+        (see Notes).
     missing_values : int, float, str, np.nan or None, default=np.nan
         The placeholder for missing values; all its occurrences are filled.
     random_state : int, RandomState instance or None, default=None
@@ -196,8 +196,7 @@ class CRBMImputer(
     out nearly as well without the frame's observed channels as with them
     (``benchmarks/fillin_baselines.py``, second split, walk, left leg
     missing, models of seeds 0-2: 3.93-4.35 against 3.85-4.17).  A leg
-    that falls out of
-    step with the observed body is then not pulled back.
+    that falls out of step with the observed body is then not pulled back.
     ``observation_gain=g`` multiplies what the hidden units see of the
     observed channels' deviation from the chain's one-step prediction by
     ``g``, a first-order version of conditioning on them with variance
@@ -205,10 +204,12 @@ class CRBMImputer(
     The prediction, not the chain's current state, is the reference, so
     the amplified input is fixed during the Gibbs run and cannot
     oscillate; the observed values themselves are kept.  The first frame
-    of a sequence, with no past, is filled with ``g = 1``.  On
-    ``benchmarks/fillin_baselines.py`` ``g = 2`` re-anchors the filled leg
-    of a walk to the observed body (second split, walk leg: 4.03-4.81
-    against 4.67-5.65 with ``g = 1``); gains above 2.5 overshoot.
+    of a sequence, with no past, is filled with ``g = 1``.  ``g = 2`` had
+    the lowest total error of 1, 1.5, 2, 2.5 and 3 on the training trials
+    of CMU subject 35.  On ``benchmarks/fillin_baselines.py`` it re-anchors
+    the filled leg of a walk to the observed body (second split, walk leg,
+    seeds 0-4: 4.43-5.37 against 4.88-6.08 with ``g = 1``) but fills the
+    fast leg of a jog worse (5.09-7.17 against 4.79-5.60).
 
     *Wholly missing frames* are generated from their past alone by the same
     on-line loop as :meth:`ConditionalRBM.sample`
