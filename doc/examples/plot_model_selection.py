@@ -208,11 +208,13 @@ fig.savefig(OUTPUT / "model_selection.png", dpi=90)
 # configurations, 500 epochs, the imputer's defaults) the rank correlation
 # between the score and minus the fill-in error among the models with history
 # is 0.73 when they are trained on clean histories (``history_noise=0``) and
-# 0.08 with the default noisy histories: their hidden units carry the pose
-# and stay uncertain given the past, more so the more of them there are, and
-# the likelihood charges for that spread while the fills, which use the
-# model's mean, do not.  Either way the configuration the search picks fills
-# in within 7% of the best of the grid.  To choose a model for filling in,
+# 0.08 to 0.11 with the default noisy histories: their hidden units carry the
+# pose and stay uncertain given the past, more so the more of them there are,
+# and the likelihood charges for that spread while the fills, which use the
+# model's mean, do not.  Training cannot take the spread away without costing
+# the fill-in (``benchmarks/model_selection_diagnostics.py training``).  The
+# configuration the search picks fills in within 3 to 10% of the best of the
+# grid.  To choose a model for filling in,
 # score the fill-in itself
 # (:func:`~sklearn_crbm.model_selection.make_imputation_scorer`).
 
