@@ -16,10 +16,12 @@ Protocol (the paper's §4.4, as ``paper_fillin.py``, with a second split):
   ``ConditionalRBM.paper_schedule(n_iter=1000)``, ``ar-init`` the defaults
   with ``init="autoregressive"`` and ``ar-init-learned`` that with
   ``visible_variance="learned"`` and ``cd_steps=5`` (both with
-  ``--ar-history-noise`` if given); ``transform`` is called once, as a
-  user would.  Each model also fills with the paper's on-line procedure
-  (``--fillins paper``: one chain, no offset correction, no observation
-  gain: ``CRBMImputer(n_particles=1, offset_shrinkage=None,
+  ``--ar-history-noise`` if given), ``bare`` ``ConditionalRBM()`` with
+  every parameter but ``random_state`` at its default (``--n-iter``
+  ignored); ``transform`` is called once, as a user would.  Each model
+  also fills with the paper's on-line procedure (``--fillins paper``: one
+  chain, no offset correction, no observation gain:
+  ``CRBMImputer(n_particles=1, offset_shrinkage=None,
   observation_gain=1)``), the defaults before the offset correction;
 - error: the paper's (per-frame mean squared error over the erased
   channels, summed over the erased frames, z-scored units).
@@ -81,6 +83,8 @@ def crbm_model(name, seed, n_iter, ar_history_noise=None):
     """The ConditionalRBM of model ``name`` (see the module docstring)."""
     if name == "paper":
         return ConditionalRBM.paper_schedule(n_iter=n_iter, random_state=seed)
+    if name == "bare":
+        return ConditionalRBM(random_state=seed)
     model = ConditionalRBM(200, order=3, n_iter=n_iter, random_state=seed)
     if name.startswith("ar-init"):
         model.set_params(init="autoregressive")
@@ -126,7 +130,7 @@ def main(argv=None):
         "--models",
         nargs="+",
         default=["default", "paper"],
-        choices=["default", "paper", "ar-init", "ar-init-learned"],
+        choices=["default", "paper", "ar-init", "ar-init-learned", "bare"],
     )
     parser.add_argument(
         "--fillins", nargs="+", default=list(FILLINS), choices=list(FILLINS)

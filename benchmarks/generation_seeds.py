@@ -5,8 +5,9 @@ Protocol:
 - one ConditionalRBM per training seed on all 33 CMU subject 35 trials
   (200 hidden units, order 3, ``--n-iter`` 1000 epochs; ``default``: every
   other parameter at its default, ``paper``:
-  ``ConditionalRBM.paper_schedule``), cached with the other generation
-  benchmarks;
+  ``ConditionalRBM.paper_schedule``; ``bare``: ``ConditionalRBM()``, every
+  parameter but ``random_state`` at its default, ``--n-iter`` ignored),
+  cached with the other generation benchmarks;
 - per training seed, 6 walk-seeded and 6 jog-seeded sequences of 1000
   frames (seeds of ``order`` real frames drawn as in
   ``generation_styles.py``; ``sample`` with its defaults);
@@ -23,6 +24,7 @@ statistics) to ``benchmarks/results/generation_seeds.json``::
 
     python benchmarks/generation_seeds.py
     python benchmarks/generation_seeds.py --models paper --seeds 0 1
+    python benchmarks/generation_seeds.py --models bare
 """
 
 import os
@@ -50,10 +52,12 @@ FREQUENCY_TOLERANCE = 0.15
 WINDOWS = {"frames 200-299": 300, "frames 900-999": 1000}  # window -> its end
 
 
-def model(name, seed, n_iter):
+def model(name, seed, n_iter, n_components=200):
     if name == "paper":
         return ConditionalRBM.paper_schedule(n_iter=n_iter, random_state=seed)
-    return ConditionalRBM(200, order=3, n_iter=n_iter, random_state=seed)
+    if name == "bare":
+        return ConditionalRBM(random_state=seed)
+    return ConditionalRBM(n_components, order=3, n_iter=n_iter, random_state=seed)
 
 
 def real_statistics(motion):
@@ -119,9 +123,12 @@ def main(argv=None):
         "--models",
         nargs="+",
         default=["default", "paper"],
-        choices=["default", "paper"],
+        choices=["default", "paper", "bare"],
     )
     parser.add_argument("--n-iter", type=int, default=1000)
+    parser.add_argument(
+        "--n-components", type=int, default=200, help="hidden units of 'default'"
+    )
     parser.add_argument(
         "--encoding",
         default="paper",
@@ -162,7 +169,7 @@ def main(argv=None):
         for seed in args.seeds:
             crbm, seconds = cached_model(
                 args.cache_dir,
-                model(name, seed, args.n_iter),
+                model(name, seed, args.n_iter, args.n_components),
                 motion.Z.astype(np.float32),
                 motion.ids,
             )
@@ -176,6 +183,7 @@ def main(argv=None):
                 row[window] = summary(stats, seed_styles)
             rows.append(row)
             report_row(row, args.n_per_style)
+    print(markdown_table(rows, args.n_per_style))
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     output.write_text(json.dumps(dict(args=vars(args), real=real, rows=rows), indent=2))
@@ -196,6 +204,30 @@ def report_row(row, n):
     print(
         f"{row['model']} seed {row['seed']}:\n    " + "\n    ".join(cells), flush=True
     )
+
+
+def markdown_table(rows, n):
+    """One line per model and seed: passes, leg amplitude and step frequency."""
+
+    def spread(values):
+        return f"{min(values):.2f}-{max(values):.2f}"
+
+    lines = [
+        "",
+        "| model | seed | fit s | window | walks pass | jogs pass "
+        "| leg amplitude walk / jog | step frequency walk / jog (Hz) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for row in rows:
+        for window in WINDOWS:
+            walk, jog = (row[window][style] for style in STYLES)
+            lines.append(
+                f"| {row['model']} | {row['seed']} | {row['train_seconds']:.1f} "
+                f"| {window} | {walk['passes']}/{n} | {jog['passes']}/{n} "
+                f"| {spread(walk['amplitude'])} / {spread(jog['amplitude'])} "
+                f"| {spread(walk['frequency'])} / {spread(jog['frequency'])} |"
+            )
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

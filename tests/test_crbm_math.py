@@ -200,9 +200,10 @@ def test_hidden_states_have_their_probabilities_as_frequencies(dtype):
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
-def test_hidden_noise_is_added_to_the_hidden_biases(dtype):
+@pytest.mark.parametrize("n", [500, 700])  # 3500 and 4900 states: both float64 tests
+def test_hidden_noise_is_added_to_the_hidden_biases(dtype, n):
     params = make_params(dtype)
-    visible, history = batch(params, n=500)
+    visible, history = batch(params, n=n)
     _, hidden_bias = dynamic_biases(params, history)
     shape = hidden_bias.shape
     out, work, noise = (np.empty(shape, dtype) for _ in range(3))

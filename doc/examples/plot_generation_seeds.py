@@ -8,7 +8,7 @@ RBM keeps generating lively walks and jogs used to depend on the seed alone
 (a walk that freezes, a jog that shuffles in place with its legs barely
 moving).  This example trains one model per training seed with the
 defaults of :class:`~sklearn_crbm.ConditionalRBM` (200 hidden units, order 3,
-1000 epochs), lets each generate 300 frames from a walk seed and from a jog
+1000 epochs: ``ConditionalRBM(random_state=seed)``), lets each generate 300 frames from a walk seed and from a jog
 seed, and draws every 4th of the last 60 generated frames beside the real
 motion, one strip per seed and style, with each sequence's leg amplitude
 (RMS of the per-channel standard deviations of the hip and knee channels
@@ -50,10 +50,10 @@ OUTPUT.mkdir(parents=True, exist_ok=True)
 
 try:
     motion = load_cmu35()
-    n_iter, seeds = 1000, [0, 1, 2, 3, 4]
+    settings, seeds = {}, [0, 1, 2, 3, 4]  # the defaults
 except FileNotFoundError:
     motion = make_walker(n_sequences=4, n_frames=120, random_state=0)
-    n_iter, seeds = 200, [0, 1]
+    settings, seeds = dict(n_iter=200), [0, 1]
 
 preprocessor = make_motion_preprocessor(motion.skeleton)
 Z = preprocessor.fit_transform(motion.data, sequence_ids=motion.sequence_ids)
@@ -86,7 +86,7 @@ real_amplitude = {
 n_new = 300
 generated = {}
 for seed in seeds:
-    model = ConditionalRBM(200, order=3, n_iter=n_iter, random_state=seed)
+    model = ConditionalRBM(random_state=seed, **settings)
     model.fit(Z.astype(np.float32), sequence_ids=motion.sequence_ids)
     frames = model.sample(n_new, history=history, random_state=seed)
     generated[seed] = frames.reshape(len(styles), n_new, -1)
