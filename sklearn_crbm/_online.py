@@ -15,6 +15,7 @@ gives the dynamic biases of the next frame.
 """
 
 from dataclasses import dataclass
+from numbers import Real
 
 import numpy as np
 from sklearn.utils._array_api import _convert_to_numpy
@@ -332,9 +333,10 @@ def run_online(
         chain's drawn entries are shifted by the chain's
         :class:`Offsets` correction (its mean one-step residual of that
         channel in that sequence so far, shrunk by ``lam`` frames).
-    observation_gain : float, default=1.0
+    observation_gain : float or ndarray of shape (n_features,), default=1.0
         Fill-in only.  The hidden units of a chain see each observed channel
-        at ``x_hat + observation_gain * (x - x_hat)`` instead of at its value
+        at ``x_hat + observation_gain * (x - x_hat)`` (a gain per channel if
+        an array) instead of at its value
         ``x``, ``x_hat`` being the chain's one-step prediction of the frame
         from its past (:func:`_one_step_predictions`): the observed
         channels' surprise counts ``observation_gain`` times.  The frame
@@ -421,6 +423,7 @@ def run_online(
         return
 
     X, missing, all_sequences = observed.X, observed.missing, observed.sequences
+    amplify = _amplifies(observation_gain)
     starts, lengths = all_sequences.starts, all_sequences.lengths
     n_features = X.shape[1]
     n_steps = int(lengths.max(initial=0)) if n_steps is None else n_steps
@@ -479,13 +482,13 @@ def run_online(
                 offsets.reorder(chains, sequences[drawn])
         biases = history.biases(sequences)
         prediction = None
-        if offsets is not None or observation_gain != 1:
+        if offsets is not None or amplify:
             prediction = _one_step_predictions(layers, biases, frames.shape)
         if offsets is not None and step >= layers[0].n_lags:
             offsets.update(prediction, sequences, frames, ~frame_missing)
         if len(drawn):
             seen = frames[drawn]
-            if observation_gain != 1:
+            if amplify:
                 seen = _amplified(seen, prediction[:, drawn], observation_gain)
             start = np.where(
                 frame_missing[drawn], history.previous(0, sequences[drawn]), seen
@@ -493,7 +496,7 @@ def run_online(
             if start_jitter:
                 start += start_jitter * rng.standard_normal(start.shape, start.dtype)
             current[:, drawn] = draw(start, [b[:, drawn] for b in biases], clamp)[0]
-            if observation_gain != 1:
+            if amplify:
                 current[:, drawn] = np.where(
                     frame_missing[drawn], current[:, drawn], frames[drawn]
                 )
@@ -533,6 +536,7 @@ def _fill_on_device(
     X, missing, sequences = observed.X, observed.missing, observed.sequences
     starts, lengths = sequences.starts, sequences.lengths
     every = slice(None)
+    amplify = _amplifies(observation_gain)
     all_sequences = np.arange(len(starts))
     has_missing = _convert_to_numpy(ops.any(missing, axis=1), ops.xp)
     for step in range(n_steps):
@@ -562,18 +566,18 @@ def _fill_on_device(
                 offsets.reorder(chains, every)
         biases = history.biases(every)
         prediction = None
-        if offsets is not None or observation_gain != 1:
+        if offsets is not None or amplify:
             prediction = _one_step_predictions(layers, biases, frames.shape)
         if offsets is not None and step >= layers[0].n_lags:
             offsets.update(prediction, every, frames, ~frame_missing)
         seen = frames
-        if observation_gain != 1:
+        if amplify:
             seen = _amplified(frames, prediction, observation_gain)
         start = ops.where(frame_missing, history.previous(0, every), seen)
         if start_jitter:
             start = start + start_jitter * rng.standard_normal(start.shape, start.dtype)
         current = draw(start, biases, clamp)[0]
-        if observation_gain != 1:
+        if amplify:
             current = ops.where(frame_missing, current, frames)
         if offsets is not None:
             current = offsets.corrected(current, every, frame_missing)
@@ -644,6 +648,11 @@ def _one_step_predictions(layers, biases, shape):
     ops = layers[0].ops
     prediction = stacked_prediction(layers, *_split(layers, biases), PREDICTION_STEPS)
     return ops.reshape(prediction, (-1, *shape))
+
+
+def _amplifies(gain):
+    """Whether ``observation_gain`` changes anything (anything but the number 1)."""
+    return not (isinstance(gain, Real) and gain == 1)
 
 
 def _amplified(frames, prediction, gain):

@@ -88,9 +88,46 @@ def test_matches_the_loop_written_out(model, data):
     assert np.abs(plain - expected)[8:, 1].max() > 1e-3
 
 
+def residual_variance(model, X, ids):
+    """Variance of ``X - predict_next(X)`` over frames with ``order`` past frames."""
+    residuals = X - model.predict_next(X, sequence_ids=ids)
+    index = np.arange(len(ids))
+    first = np.r_[True, ids[1:] != ids[:-1]]
+    position = index - np.maximum.accumulate(np.where(first, index, 0))
+    return np.var(residuals[position >= model.order], axis=0)
+
+
+def test_residual_variance_is_that_of_the_one_step_residuals(model, data):
+    X, ids = data
+    imputer = CRBMImputer(FrozenEstimator(model)).fit(X, sequence_ids=ids)
+    expected = residual_variance(model, X, ids)
+    assert_allclose(imputer.residual_variance_, expected, rtol=1e-10)
+    # a gap splits a sequence: frames right after it have no full past
+    X_gap = X.copy()
+    X_gap[10, 0] = np.nan
+    imputer.fit(X_gap, sequence_ids=ids)
+    runs = ids + (np.arange(len(ids)) > 10) * (ids == 0) * 100
+    keep = ~np.isnan(X_gap).any(axis=1)
+    assert_allclose(
+        imputer.residual_variance_,
+        residual_variance(model, X_gap[keep], runs[keep]),
+        rtol=1e-10,
+    )
+
+
+def channel_gains(model, X, ids, gain):
+    """``observation_weighting="residual"``: ``1 + (g - 1) min(m / v_j, 3)``."""
+    variance = residual_variance(model, X, ids)
+    weights = np.minimum(np.median(variance) / variance, 3)
+    return np.maximum(1 + (gain - 1) * weights, 0)
+
+
 @pytest.mark.parametrize("shrinkage", [None, 2.5])
 @pytest.mark.parametrize("gain", [0.0, 3.0])
-def test_observation_gain_matches_the_loop_written_out(model, data, shrinkage, gain):
+@pytest.mark.parametrize("weighting", ["uniform", "residual"])
+def test_observation_gain_matches_the_loop_written_out(
+    model, data, shrinkage, gain, weighting
+):
     X, ids = data
     X_missing = X[ids == 2].copy()
     X_missing[10:, 0] = np.nan
@@ -101,8 +138,12 @@ def test_observation_gain_matches_the_loop_written_out(model, data, shrinkage, g
         n_particles=1,
         offset_shrinkage=shrinkage,
         observation_gain=gain,
-    ).fit(X)
-    expected = reference_fill(model, X_missing, shrinkage, gain)
+        observation_weighting=weighting,
+    ).fit(X, sequence_ids=ids)
+    gains = gain if weighting == "uniform" else channel_gains(model, X, ids, gain)
+    if weighting == "residual" and gain > 1:
+        assert np.ptp(gains) > 0.1  # the channels do get different gains
+    expected = reference_fill(model, X_missing, shrinkage, gains)
     filled = imputer.transform(X_missing)
     assert_allclose(filled, expected, rtol=1e-10, atol=1e-12)
     observed = ~np.isnan(X_missing)
@@ -125,6 +166,7 @@ def test_gain_zero_ignores_the_frame_s_observed_values(model, data):
         n_particles=4,
         offset_shrinkage=None,
         observation_gain=0.0,
+        observation_weighting="uniform",
         random_state=0,
     ).fit(X)
     filled, moved = imputer.transform(X_missing), imputer.transform(X_moved)
@@ -182,10 +224,17 @@ def test_complete_frames_and_observed_values_are_untouched(model, data):
     assert np.isfinite(filled).all()
 
 
-@pytest.mark.parametrize("name", ["offset_shrinkage", "observation_gain"])
-def test_negative_shrinkage_and_gain_are_rejected(data, name):
+@pytest.mark.parametrize(
+    "name, value",
+    [
+        ("offset_shrinkage", -1),
+        ("observation_gain", -1),
+        ("observation_weighting", "variance"),
+    ],
+)
+def test_bad_inference_parameters_are_rejected(data, name, value):
     X, _ = data
-    imputer = CRBMImputer(ConditionalRBM(3, n_iter=1), **{name: -1})
+    imputer = CRBMImputer(ConditionalRBM(3, n_iter=1), **{name: value})
     with pytest.raises(InvalidParameterError, match=name):
         imputer.fit(X)
 
