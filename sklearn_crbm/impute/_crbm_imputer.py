@@ -18,6 +18,7 @@ from sklearn.utils._param_validation import (
     MissingValues,
     StrOptions,
 )
+from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted
 
 from .._base import check_count
@@ -33,6 +34,18 @@ from ..utils._threads import chain_rows, limit_blas_threads
 from ._base import check_imputer_input, check_same_place, complete_runs
 from ._base import to_numpy as _to_numpy
 
+
+
+def _default_model(random_state):
+    """``ConditionalRBM()`` with a training seed drawn from ``random_state``.
+
+    ``None`` stays ``None``; an int or RandomState gives one int, the way
+    scikit-learn's ensembles seed the estimators they build.
+    """
+    if random_state is None:
+        return ConditionalRBM()
+    seed = check_random_state(random_state).randint(np.iinfo(np.int32).max)
+    return ConditionalRBM(random_state=seed)
 
 class CRBMImputer(
     VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
@@ -58,7 +71,8 @@ class CRBMImputer(
         already is used as it is, without training, when wrapped in
         :class:`sklearn.frozen.FrozenEstimator`:
         ``CRBMImputer(FrozenEstimator(model))``.  ``None`` means
-        ``ConditionalRBM()``, whose default ``history_noise=0.8`` trains on
+        ``ConditionalRBM()``, seeded from ``random_state`` (see there), whose
+        default ``history_noise=0.8`` trains on
         noisy histories so that on-line fills do not drift (see Notes; with
         :meth:`ConditionalRBM.paper_schedule` the filled upper body of a
         walk drifts for some training seeds).  Standardise the data first (e.g. with
@@ -121,8 +135,10 @@ class CRBMImputer(
         The placeholder for missing values; all its occurrences are filled.
     random_state : int, RandomState instance or None, default=None
         Seeds the Gibbs sampling of :meth:`transform`; pass an int for
-        reproducible fills.  The estimator keeps its own ``random_state``
-        for training.
+        reproducible fills.  A given ``estimator`` keeps its own
+        ``random_state`` for training; with ``estimator=None`` the default
+        ``ConditionalRBM`` is trained with a seed drawn from this one, so the
+        same int gives the same model and the same fills.
     n_jobs : int, default=None
         Number of jobs filling blocks of sequences in parallel (joblib).
         Up to 32 sequences are filled together, vectorised, as one block;
@@ -374,7 +390,7 @@ class CRBMImputer(
             X = ops.take(X, rows, axis=0)
             estimator = self.estimator
             if estimator is None:
-                estimator = ConditionalRBM()
+                estimator = _default_model(self.random_state)
             if isinstance(estimator, FrozenEstimator):
                 self.estimator_ = _check_frozen(estimator.estimator, X)
             else:

@@ -215,6 +215,27 @@ def test_default_estimator_is_a_conditional_rbm():
     assert imputer.estimator is None
 
 
+def test_default_estimator_is_seeded_from_random_state():
+    X, ids = make_oscillations(n_sequences=2, n_frames=20, n_features=3, random_state=0)
+    X_missing = X.copy()
+    X_missing[25:, 1] = np.nan
+    fits = [
+        CRBMImputer(n_gibbs=2, random_state=seed).fit(X, sequence_ids=ids)
+        for seed in (0, 0, 1)
+    ]
+    assert isinstance(fits[0].estimator_.random_state, int)
+    assert_array_equal(fits[0].estimator_.components_, fits[1].estimator_.components_)
+    assert not np.array_equal(
+        fits[0].estimator_.components_, fits[2].estimator_.components_
+    )
+    assert_array_equal(
+        fits[0].transform(X_missing, sequence_ids=ids),
+        fits[1].transform(X_missing, sequence_ids=ids),
+    )
+    unseeded = CRBMImputer(n_gibbs=2).fit(X, sequence_ids=ids)
+    assert unseeded.estimator_.random_state is None
+
+
 def test_frozen_fitted_model_is_used_without_training(test_data):
     X, ids = make_oscillations(n_sequences=6, n_frames=40, n_features=5, random_state=0)
     params = dict(n_components=12, order=2, n_iter=20, random_state=0)
