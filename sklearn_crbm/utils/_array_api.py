@@ -278,31 +278,22 @@ class ArrayRandom:
         return np.float32 if dtype == self.ops.float32 else np.float64
 
     def random(self, shape, dtype=None, out=None):
-        dtype = self.ops.float64 if dtype is None else dtype
-        if self._torch is not None:
-            import torch
-
-            draws = torch.rand(
-                shape, generator=self._torch, dtype=dtype, device=self.ops.device
-            )
-        else:
-            draws = self.ops.asarray(
-                self._numpy.random(shape, dtype=self._numpy_dtype(dtype))
-            )
-        return self.ops._into(out, draws)
+        return self._draw("rand", "random", shape, dtype, out)
 
     def standard_normal(self, shape, dtype=None, out=None):
+        return self._draw("randn", "standard_normal", shape, dtype, out)
+
+    def _draw(self, torch_name, numpy_name, shape, dtype, out):
         dtype = self.ops.float64 if dtype is None else dtype
         if self._torch is not None:
             import torch
 
-            draws = torch.randn(
+            draws = getattr(torch, torch_name)(
                 shape, generator=self._torch, dtype=dtype, device=self.ops.device
             )
         else:
-            draws = self.ops.asarray(
-                self._numpy.standard_normal(shape, dtype=self._numpy_dtype(dtype))
-            )
+            numpy_draw = getattr(self._numpy, numpy_name)
+            draws = self.ops.asarray(numpy_draw(shape, dtype=self._numpy_dtype(dtype)))
         return self.ops._into(out, draws)
 
 
