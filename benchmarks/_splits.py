@@ -85,7 +85,7 @@ _TRAINING_PARAMETERS = (
 
 # Training parameters added later, with the value the fits cached before had:
 # in the key only when they differ from it.
-_LATER_PARAMETERS = {"init": "random"}
+_LATER_PARAMETERS = {"init": "random", "centering": False}
 
 # The code a fit runs: a change to any of these (e.g. a new random stream)
 # changes the fitted models, so their text is part of the key too.

@@ -16,7 +16,8 @@ Protocol (the paper's §4.4, as ``paper_fillin.py``, with a second split):
   ``ConditionalRBM.paper_schedule(n_iter=1000)``, ``ar-init`` the defaults
   with ``init="autoregressive"`` and ``ar-init-learned`` that with
   ``visible_variance="learned"`` and ``cd_steps=5`` (both with
-  ``--ar-history-noise`` if given), ``bare`` ``ConditionalRBM()`` with
+  ``--ar-history-noise`` if given), ``centred`` the defaults with
+  ``centering=True``, ``bare`` ``ConditionalRBM()`` with
   every parameter but ``random_state`` at its default (``--n-iter``
   ignored); ``transform`` is called once, as a user would.  Each model
   also fills with the paper's on-line procedure (``--fillins paper``: one
@@ -92,6 +93,8 @@ def crbm_model(name, seed, n_iter, ar_history_noise=None):
             model.set_params(history_noise=ar_history_noise)
     if name == "ar-init-learned":
         model.set_params(visible_variance="learned", cd_steps=5)
+    if name == "centred":
+        model.set_params(centering=True)
     return model
 
 
@@ -130,7 +133,7 @@ def main(argv=None):
         "--models",
         nargs="+",
         default=["default", "paper"],
-        choices=["default", "paper", "ar-init", "ar-init-learned", "bare"],
+        choices=["default", "paper", "ar-init", "ar-init-learned", "bare", "centred"],
     )
     parser.add_argument(
         "--fillins", nargs="+", default=list(FILLINS), choices=list(FILLINS)

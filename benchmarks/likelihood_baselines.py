@@ -21,6 +21,11 @@ sampling otherwise).
   and hidden biases ``b - W (c / (s sigma))``, so that the hidden units
   see the residual), written into a ``ConditionalRBM`` and scored as the
   others: what a CRBM whose hidden units model the AR's residuals gets;
+- ``centred`` (``--rows centred``): ``ConditionalRBM(200, order=3,
+  init="autoregressive", visible_variance="residual", centering=True)``,
+  the ridge AR's residual variances kept fixed and the gradient taken in
+  centred coordinates; epochs and history noise chosen on validation as
+  for ``learned``; ``uncentred`` is the same without ``centering``;
 - ``default``: the defaults (unit variances) of ``fillin_baselines.py``,
   1000 epochs, for ``--default-seeds``;
 - baselines: the ridge AR(3) of ``AutoregressiveImputer`` (alpha 1) with
@@ -40,6 +45,8 @@ Prints the table and writes JSON to
 
     python benchmarks/likelihood_baselines.py
     python benchmarks/likelihood_baselines.py --seeds 0 --splits paper
+    python benchmarks/likelihood_baselines.py --rows centred uncentred \
+        --history-noise 0 0.1 0.2 --checkpoints 10 20 40 60 100 --test-ais 500 16
     python benchmarks/likelihood_baselines.py --init autoregressive \
         --history-noise 0 0.2 0.4 0.8 --checkpoints 1 2 3 5 10 25 50 100 \
         --default-seeds --output benchmarks/results/likelihood_ar_init.json
@@ -131,19 +138,25 @@ def validation_split(split):
     return (split.X_train[~held], ids[~held]), (split.X_train[held], ids[held])
 
 
-def learned_model(seed, init="random", history_noise=0.8):
-    return ConditionalRBM(
-        200,
-        order=ORDER,
-        visible_variance="learned",
-        cd_steps=5,
-        init=init,
-        history_noise=history_noise,
-        random_state=seed,
+# The CRBM rows trained with checkpoints, by name: their parameters beyond
+# 200 hidden units, order 3, the seed and the history noise.
+ROW_PARAMETERS = {
+    "learned": dict(visible_variance="learned", cd_steps=5),
+    "centred": dict(visible_variance="residual", init="autoregressive", centering=True),
+    "uncentred": dict(visible_variance="residual", init="autoregressive"),
+}
+
+
+def row_model(row, seed, init="random", history_noise=0.8):
+    model = ConditionalRBM(
+        200, order=ORDER, init=init, history_noise=history_noise, random_state=seed
     )
+    return model.set_params(**ROW_PARAMETERS[row])
 
 
-def chosen_by_validation(split, seed, checkpoints, init="random", noises=(0.8,)):
+def chosen_by_validation(
+    split, seed, checkpoints, init="random", noises=(0.8,), row="learned"
+):
     """Train with checkpoints; the one with the best validation log-likelihood.
 
     Returns the model, its ``(history noise, epochs)`` and every validation
@@ -155,7 +168,7 @@ def chosen_by_validation(split, seed, checkpoints, init="random", noises=(0.8,))
     best = (-np.inf, None, None)
     scores = {}
     for noise in noises:
-        model = learned_model(seed, init, noise)
+        model = row_model(row, seed, init, noise)
         for epoch in range(1, max(checkpoints) + 1):
             model.partial_fit(X, sequence_ids=ids)
             if epoch in checkpoints:
@@ -233,8 +246,9 @@ def main(argv=None):
         "--rows",
         nargs="+",
         default=["learned"],
-        choices=["learned", "residual"],
-        help="CRBM rows for --seeds: learned variances, residual RBM",
+        choices=["learned", "residual", "centred", "uncentred"],
+        help="CRBM rows for --seeds: learned variances (--init), residual RBM, "
+        "the ridge AR's residual variances with and without centering",
     )
     parser.add_argument(
         "--test-ais",
@@ -267,18 +281,24 @@ def main(argv=None):
         X_test = split.X_test.astype(np.float32)
         rows = {}
         for seed in args.seeds:
-            if "learned" in args.rows:
+            for row in (r for r in args.rows if r in ROW_PARAMETERS):
                 model, (noise, epochs), validation = chosen_by_validation(
-                    split, seed, set(args.checkpoints), args.init, args.history_noise
+                    split,
+                    seed,
+                    set(args.checkpoints),
+                    args.init,
+                    args.history_noise,
+                    row,
                 )
-                rows.setdefault(f"learned, init={args.init}", {})[seed] = dict(
+                name = f"learned, init={args.init}" if row == "learned" else row
+                rows.setdefault(name, {})[seed] = dict(
                     **test_scores(model, X_test, split.test_ids, frames, args.test_ais),
                     epochs=epochs,
                     history_noise=noise,
                     validation=validation,
                 )
                 print(
-                    f"  {split_name} learned seed {seed}: history noise {noise}, "
+                    f"  {split_name} {row} seed {seed}: history noise {noise}, "
                     f"{epochs} epochs",
                     flush=True,
                 )

@@ -277,7 +277,11 @@ class CRBMParameters:
         The buffer to view; zeros if None.
     learned_variance : bool, default=False
         Whether ``log_visible_variance`` is trained (Gaussian visibles
-        only); if False it is 0 and the math takes the unit-variance path.
+        only).
+    fixed_variance : bool, default=False
+        Whether ``log_visible_variance`` holds variances that training
+        keeps as they are.  With neither flag it is 0 and the math takes
+        the unit-variance path.
     layout : {"C", "F"}, default="C"
         Memory order of the 2-D groups inside ``flat``.  Training works in
         "F", the orientation in which BLAS runs its products fastest;
@@ -303,10 +307,12 @@ class CRBMParameters:
         flat=None,
         layout="C",
         learned_variance=False,
+        fixed_variance=False,
         ops=np,
     ):
         self.n_features = n_features
         self.learned_variance = learned_variance
+        self.fixed_variance = fixed_variance
         self.n_components = n_components
         self.order = order
         self.hidden_order = hidden_order
@@ -346,7 +352,7 @@ class CRBMParameters:
     @property
     def visible_std(self):
         """``s``, shape ``(n_features,)``; None for unit variance (the fast path)."""
-        if not self.learned_variance:
+        if not (self.learned_variance or self.fixed_variance):
             return None
         return self.ops.exp(0.5 * self.log_visible_variance)
 
@@ -386,6 +392,7 @@ class CRBMParameters:
         rng,
         *,
         learned_variance=False,
+        fixed_variance=False,
     ):
         """The original code's initialisation (REFERENCE.md).
 
@@ -401,6 +408,7 @@ class CRBMParameters:
             visible_type,
             dtype,
             learned_variance=learned_variance,
+            fixed_variance=fixed_variance,
         )
         for group in GROUPS:
             getattr(params, group.name)[...] = group.initial(params, rng)
@@ -424,6 +432,7 @@ class CRBMParameters:
             self.dtype,
             layout=self.layout if layout is None else layout,
             learned_variance=self.learned_variance,
+            fixed_variance=self.fixed_variance,
             ops=self.ops,
         )
 
@@ -478,6 +487,7 @@ class CRBMParameters:
 
     def __setstate__(self, state):
         vars(self).update(state)
+        self.__dict__.setdefault("fixed_variance", False)
         if "learned_variance" not in state:  # pickled before variances were a group
             self.learned_variance = False
             self.flat = np.concatenate(
@@ -813,6 +823,7 @@ def cd_gradients(
     out=None,
     scale=1.0,
     workspace=None,
+    centered=False,
 ):
     """Contrastive-divergence statistics of one minibatch (paper Eqs. 4-7, §2.2).
 
@@ -846,6 +857,18 @@ def cd_gradients(
     not the products.  :class:`MomentumUpdate` turns the statistics into
     parameter updates.
 
+    With ``centered=True``, ``params`` holds the centred coordinates of
+    :func:`shift_centred` (the hidden units see ``(v - c_hat) / s``, the
+    residual against the dynamic visible bias) and the statistics are their
+    gradients: by the chain rule, those above with, per frame and with
+    ``dh = h_data - h_recon``, ``-dh (c_hat / s)`` added to the weights',
+    ``-s * (W.T dh)`` to the visible delta (so to the visible bias and
+    autoregressive statistics) and ``c_hat (W.T dh) / (2 s)`` to that of
+    ``log s^2``; the hidden and past-to-hidden statistics are unchanged.
+    Their steps do not drag the hidden units' dynamic biases along with
+    every change of the visible mean (Montavon & Müller's centring, Cho,
+    Raiko & Ilin's enhanced gradient).
+
     Parameters
     ----------
     params : CRBMParameters
@@ -858,6 +881,8 @@ def cd_gradients(
     scale : float
     workspace : CDWorkspace, default=None
         Buffers for minibatches of at least ``n`` frames.
+    centered : bool, default=False
+        Whether ``params`` are centred coordinates (see above).
 
     Returns
     -------
@@ -887,6 +912,10 @@ def cd_gradients(
     visible_bias, hidden_bias = dynamic_biases(
         params, history, out=workspace.biases[:n, ...]
     )
+    std = params.visible_std
+    if centered:  # the hidden input of the standard form: b_hat - W (c_hat / s)
+        centre = visible_bias if std is None else visible_bias / std
+        hidden_bias -= ops.matmul(centre, params.weights.T)
     sample_hidden = HiddenSampler(params, hidden_bias)
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
         sample_hidden(data, rng, out=positive_states, work=workspace.hidden[:n, ...])
@@ -931,13 +960,17 @@ def cd_gradients(
         )
     else:
         out.log_visible_variance[...] = 0
+    if centered:
+        _centre_statistics(params, visible_bias, delta, d, scale, out)
     # the scale goes into the small factors: [v; -v_recon] and delta; W's
     # statistics are those of v / s
-    visible_scale = scale if not learned else scale / params.visible_std
+    visible_scale = scale if std is None else scale / std
     data *= visible_scale
     ops.multiply(reconstruction, -visible_scale, out=reconstruction)
     delta *= scale
     ops.matmul(stacked_hidden.T, stacked_visible, out=out.weights)
+    if centered:
+        out.weights -= ops.matmul(delta[:, d:].T, centre)
     bias_sums = ops.dot(workspace.ones[:n], delta, out=workspace.bias_sums)
     out.visible_bias[...] = bias_sums[:d]
     out.hidden_bias[...] = bias_sums[d:]
@@ -946,6 +979,47 @@ def cd_gradients(
         if workspace.dynamic_mask is not None:
             out.dynamic *= workspace.dynamic_mask
     return out, squared_error
+
+
+def _centre_statistics(params, visible_bias, delta, d, scale, out):
+    """The chain-rule terms of the centred coordinates (see cd_gradients).
+
+    Changes the visible part of ``delta`` (not yet scaled) and, with learned
+    variances, the statistic of ``log s^2`` in ``out``.
+    """
+    ops = params.ops
+    back = ops.matmul(delta[:, d:], params.weights)  # W.T dh, frame by frame
+    std = params.visible_std
+    if params.learned_variance:
+        term = ops.sum(visible_bias * back, axis=0) / (2 * std)
+        out.log_visible_variance[...] = out.log_visible_variance + scale * term
+    if std is not None:
+        back *= std
+    delta[:, :d] -= back
+
+
+def shift_centred(params, direction):
+    """Move ``params`` in place to centred coordinates (``+1``) or back (``-1``).
+
+    In centred coordinates the hidden units see the residual against the
+    dynamic visible bias, ``b' + B' x_past + W ((v - c_hat) / s)``: the same
+    model as the standard form ``b + B x_past + W (v / s)`` with ``b = b' -
+    W (c / s)`` and ``B_q = B'_q - W diag(1 / s) A_q``, where ``c`` and
+    ``A`` are the static visible bias and the autoregressive weights.
+    Needs ``hidden_order >= order``.
+    """
+    ops = params.ops
+    n = params.n_features
+    std = params.visible_std
+    weights = params.weights if std is None else params.weights / std
+    params.hidden_bias[...] = params.hidden_bias + direction * ops.matmul(
+        weights, params.visible_bias
+    )
+    width = params.order * n
+    if width:
+        shift = ops.matmul(weights, params.dynamic[:n, :width])
+        params.dynamic[n:, :width] = params.dynamic[n:, :width] + direction * shift
+    return params
 
 
 def _log_variance_statistic(

@@ -72,7 +72,7 @@ def started(monkeypatch, X, ids, **params):
     return model.fit(X, sequence_ids=ids)
 
 
-@pytest.mark.parametrize("visible_variance", ["unit", "learned"])
+@pytest.mark.parametrize("visible_variance", ["unit", "learned", "residual"])
 def test_start_is_sklearn_ridge_on_the_training_windows(
     monkeypatch, data, visible_variance
 ):
@@ -82,7 +82,7 @@ def test_start_is_sklearn_ridge_on_the_training_windows(
     coef, intercept, residual = ridge(*windows(X, ids, HIDDEN_ORDER, ORDER))
     assert_allclose(model.autoregressive_, coef, atol=1e-10)
     assert_allclose(model.intercept_visible_, intercept, atol=1e-10)
-    expected = np.mean(residual**2, axis=0) if visible_variance == "learned" else 1.0
+    expected = np.mean(residual**2, axis=0) if visible_variance != "unit" else 1.0
     assert_allclose(model.visible_variance_, np.broadcast_to(expected, (3,)))
     # the other groups keep the random start, drawn as init="random" draws it
     random = ConditionalRBM(
@@ -154,6 +154,22 @@ def test_partial_fit_starts_from_its_first_batch(monkeypatch, data):
     assert_allclose(model.autoregressive_, coef, atol=1e-10)
     model.partial_fit(X[~first], sequence_ids=ids[~first])  # not restarted
     assert_allclose(model.autoregressive_, coef, atol=1e-10)
+
+
+def test_residual_variances_stay_as_the_ridge_residuals_left_them(data):
+    """``visible_variance="residual"``: set from the ridge AR, never trained."""
+    X, ids = data
+    model = ConditionalRBM(
+        3, order=ORDER, hidden_order=HIDDEN_ORDER, visible_variance="residual"
+    )
+    model.set_params(n_iter=20, random_state=0).fit(X, sequence_ids=ids)
+    _, _, residual = ridge(*windows(X, ids, HIDDEN_ORDER, ORDER))
+    assert_allclose(model.visible_variance_, np.mean(residual**2, axis=0))
+    # with init="random" only the variances come from the AR
+    random = ConditionalRBM(3, order=ORDER, hidden_order=HIDDEN_ORDER, n_iter=20)
+    random.set_params(random_state=0).fit(X, sequence_ids=ids)
+    assert np.abs(model.autoregressive_ - random.autoregressive_).max() > 0
+    assert np.abs(model.autoregressive_).max() < 0.5
 
 
 def test_binary_visibles_cannot_start_autoregressive():

@@ -56,6 +56,14 @@ def _tested_estimators():
     yield ConditionalRBM(
         n_components=8, n_iter=5, init="autoregressive", random_state=0
     )
+    yield ConditionalRBM(
+        n_components=8,
+        n_iter=5,
+        init="autoregressive",
+        visible_variance="residual",
+        centering=True,
+        random_state=0,
+    )
     yield StackedCRBM((8, 6), order=3, n_iter=5, random_state=0)
     yield CRBMImputer(
         ConditionalRBM(n_components=8, n_iter=5, random_state=0),

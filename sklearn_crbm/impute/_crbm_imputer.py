@@ -11,6 +11,7 @@ from sklearn.base import (
     clone,
 )
 from sklearn.frozen import FrozenEstimator
+from sklearn.utils import check_random_state
 from sklearn.utils._missing import is_scalar_nan
 from sklearn.utils._param_validation import (
     HasMethods,
@@ -18,7 +19,6 @@ from sklearn.utils._param_validation import (
     MissingValues,
     StrOptions,
 )
-from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted
 
 from .._base import check_count
@@ -35,7 +35,6 @@ from ._base import check_imputer_input, check_same_place, complete_runs
 from ._base import to_numpy as _to_numpy
 
 
-
 def _default_model(random_state):
     """``ConditionalRBM()`` with a training seed drawn from ``random_state``.
 
@@ -46,6 +45,7 @@ def _default_model(random_state):
         return ConditionalRBM()
     seed = check_random_state(random_state).randint(np.iinfo(np.int32).max)
     return ConditionalRBM(random_state=seed)
+
 
 class CRBMImputer(
     VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
