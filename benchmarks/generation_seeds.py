@@ -6,7 +6,8 @@ Protocol:
   (200 hidden units, order 3, ``--n-iter`` 1000 epochs; ``default``: every
   other parameter at its default, ``paper``:
   ``ConditionalRBM.paper_schedule``; ``bare``: ``ConditionalRBM()``, every
-  parameter but ``random_state`` at its default, ``--n-iter`` ignored),
+  parameter but ``random_state`` at its default, ``--n-iter`` ignored;
+  ``centred``: ``default`` with ``centering=True``),
   cached with the other generation benchmarks;
 - per training seed, 6 walk-seeded and 6 jog-seeded sequences of 1000
   frames (seeds of ``order`` real frames drawn as in
@@ -57,7 +58,8 @@ def model(name, seed, n_iter, n_components=200):
         return ConditionalRBM.paper_schedule(n_iter=n_iter, random_state=seed)
     if name == "bare":
         return ConditionalRBM(random_state=seed)
-    return ConditionalRBM(n_components, order=3, n_iter=n_iter, random_state=seed)
+    default = ConditionalRBM(n_components, order=3, n_iter=n_iter, random_state=seed)
+    return default.set_params(centering=name == "centred")
 
 
 def real_statistics(motion):
@@ -123,7 +125,7 @@ def main(argv=None):
         "--models",
         nargs="+",
         default=["default", "paper"],
-        choices=["default", "paper", "bare"],
+        choices=["default", "paper", "bare", "centred"],
     )
     parser.add_argument("--n-iter", type=int, default=1000)
     parser.add_argument(

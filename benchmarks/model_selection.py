@@ -193,6 +193,7 @@ def model_parameters(n_components, order, args):
         order=order,
         n_iter=args.n_iter,
         history_noise=history_noise(args),
+        centering=args.centering,
         random_state=args.seed,
     )
 
@@ -203,13 +204,21 @@ def imputer_parameters(args):
     return paper if args.paper_fillin else {}
 
 
+# Parameters added after fits were cached, with the value those fits had:
+# left out of the key at that value, so the earlier fits stay valid.
+_LATER_PARAMETERS = {"centering": False}
+
+
 def _digest(estimator, leave_out=()):
     """Eight hex digits naming every parameter of ``estimator``, defaults included.
 
     Part of every cache key, so that a changed default is a new key.
     """
     params = {
-        k: v for k, v in estimator.get_params(deep=False).items() if k not in leave_out
+        k: v
+        for k, v in estimator.get_params(deep=False).items()
+        if k not in leave_out
+        and not (k in _LATER_PARAMETERS and v == _LATER_PARAMETERS[k])
     }
     return hashlib.sha1(repr(sorted(params.items())).encode()).hexdigest()[:8]
 
@@ -354,6 +363,9 @@ def main(argv=None):
         type=float,
         default=None,
         help="ConditionalRBM's history_noise (default: the estimator's default)",
+    )
+    parser.add_argument(
+        "--centering", action="store_true", help="ConditionalRBM(centering=True)"
     )
     parser.add_argument(
         "--paper-fillin",
