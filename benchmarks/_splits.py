@@ -73,13 +73,17 @@ class Split:
         )
 
 
+# The noise of ConditionalRBM's defaults before history_noise_fraction (on
+# every channel of the history): the earlier tables' models spell it out.
+EVERY_CHANNEL_NOISE = dict(history_noise=0.8, history_noise_fraction=1.0)
+
 # What a trained model depends on: the cache key leaves out parameters that
 # only affect inference (and any added later), so changes to inference reuse
 # the fits.
 _TRAINING_PARAMETERS = (
     "n_components order hidden_order visible_type visible_variance learning_rate "
     "momentum momentum_delay weight_decay cd_steps batch_size batching "
-    "history_noise n_iter random_state"
+    "history_noise history_noise_fraction n_iter random_state"
 ).split()
 
 

@@ -13,10 +13,12 @@ Protocol (the paper's §4.4, as ``paper_fillin.py``, with a second split):
 - CRBM models (``--models``), one per training seed: ``default`` is
   ``CRBMImputer(ConditionalRBM(200, order=3, n_iter=1000))`` with every
   other parameter of both at its default, ``paper`` the same with
-  ``ConditionalRBM.paper_schedule(n_iter=1000)``, ``ar-init`` the defaults
+  ``ConditionalRBM.paper_schedule(n_iter=1000)``, ``every-channel`` the
+  defaults before ``history_noise_fraction`` (``history_noise=0.8`` on
+  every channel: ``_splits.EVERY_CHANNEL_NOISE``), ``ar-init`` that
   with ``init="autoregressive"`` and ``ar-init-learned`` that with
   ``visible_variance="learned"`` and ``cd_steps=5`` (both with
-  ``--ar-history-noise`` if given), ``centred`` the defaults with
+  ``--ar-history-noise`` if given), ``centred`` ``every-channel`` with
   ``centering=True``, ``density`` the centred density model of
   ``likelihood_baselines.py`` (``init="autoregressive"``,
   ``visible_variance="residual"``, ``centering=True``, clean histories, 60
@@ -50,7 +52,13 @@ import tempfile  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
-from _splits import CELLS, SPLITS, Split, cached_model  # noqa: E402
+from _splits import (  # noqa: E402
+    CELLS,
+    EVERY_CHANNEL_NOISE,
+    SPLITS,
+    Split,
+    cached_model,
+)
 from sklearn.frozen import FrozenEstimator  # noqa: E402
 from sklearn.impute import KNNImputer  # noqa: E402
 
@@ -101,6 +109,8 @@ def crbm_model(name, seed, n_iter, ar_history_noise=None):
     if name == "bare":
         return ConditionalRBM(random_state=seed)
     model = ConditionalRBM(200, order=3, n_iter=n_iter, random_state=seed)
+    if name in ("every-channel", "centred") or name.startswith("ar-init"):
+        model.set_params(**EVERY_CHANNEL_NOISE)  # measured at the defaults of then
     if name.startswith("ar-init"):
         model.set_params(init="autoregressive")
         if ar_history_noise is not None:
@@ -157,6 +167,7 @@ def main(argv=None):
             "bare",
             "centred",
             "density",
+            "every-channel",
         ],
     )
     parser.add_argument(

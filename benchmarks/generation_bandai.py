@@ -6,7 +6,8 @@ position channels on every joint, a static ``joint_Root`` above the moving
 ``Hips``; 30 Hz, 224 to 285 frames each) go through the *default* pipeline,
 ``make_motion_preprocessor(skeleton)`` (exponential maps measured from each
 joint's mean rotation, exact yaw-pitch-roll root, z-scores), and train a
-``ConditionalRBM(200, order=3, history_noise=0.8)`` (the CLI demo's model) for
+``ConditionalRBM(200, order=3, history_noise=0.8, history_noise_fraction=1)``
+(the CLI demo's model until the default noise changed) for
 ``--n-iter`` epochs.  The model generates ``--n-sequences`` sequences of
 ``--n-frames`` frames, seeded with windows of real training frames; the frames
 go back through the exact ``inverse_transform`` to BVH channels and through
@@ -103,7 +104,12 @@ def run(walks, *, n_iter, seed, n_sequences, n_frames, encoding):
         pre = make_motion_preprocessor(skeleton, **ENCODINGS[encoding])
         Z = pre.fit_transform(walks.data, sequence_ids=ids)
     model = ConditionalRBM(
-        200, order=3, n_iter=n_iter, history_noise=0.8, random_state=seed
+        200,
+        order=3,
+        n_iter=n_iter,
+        history_noise=0.8,
+        history_noise_fraction=1.0,
+        random_state=seed,
     )
     start = time.perf_counter()
     model.fit(Z.astype(np.float32), sequence_ids=ids)

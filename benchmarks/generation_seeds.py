@@ -7,7 +7,9 @@ Protocol:
   other parameter at its default, ``paper``:
   ``ConditionalRBM.paper_schedule``; ``bare``: ``ConditionalRBM()``, every
   parameter but ``random_state`` at its default, ``--n-iter`` ignored;
-  ``centred``: ``default`` with ``centering=True``),
+  ``every-channel``: ``default`` with the noise of the defaults before
+  ``history_noise_fraction``, ``history_noise=0.8`` on every channel;
+  ``centred``: that with ``centering=True``),
   cached with the other generation benchmarks;
 - per training seed, 6 walk-seeded and 6 jog-seeded sequences of 1000
   frames (seeds of ``order`` real frames drawn as in
@@ -39,7 +41,7 @@ import tempfile  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
-from _splits import cached_model  # noqa: E402
+from _splits import EVERY_CHANNEL_NOISE, cached_model  # noqa: E402
 from generation_styles import Motion, draw_seeds, judge  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
@@ -59,6 +61,8 @@ def model(name, seed, n_iter, n_components=200):
     if name == "bare":
         return ConditionalRBM(random_state=seed)
     default = ConditionalRBM(n_components, order=3, n_iter=n_iter, random_state=seed)
+    if name in ("every-channel", "centred"):
+        default.set_params(**EVERY_CHANNEL_NOISE)  # the defaults of then
     return default.set_params(centering=name == "centred")
 
 
@@ -125,7 +129,7 @@ def main(argv=None):
         "--models",
         nargs="+",
         default=["default", "paper"],
-        choices=["default", "paper", "bare", "centred"],
+        choices=["default", "paper", "bare", "centred", "every-channel"],
     )
     parser.add_argument("--n-iter", type=int, default=1000)
     parser.add_argument(

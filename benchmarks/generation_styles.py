@@ -320,8 +320,8 @@ def train_crbm(cache_dir, Z, ids, seed, n_iter, params):
 
 def variant_params(name, history_noise):
     params = dict(VARIANTS[name])
-    if "history_noise" in params:
-        params["history_noise"] = history_noise
+    if "history_noise" in params:  # on every channel, as when these were measured
+        params.update(history_noise=history_noise, history_noise_fraction=1.0)
     return params
 
 

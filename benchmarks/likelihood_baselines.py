@@ -149,7 +149,12 @@ ROW_PARAMETERS = {
 
 def row_model(row, seed, init="random", history_noise=0.8):
     model = ConditionalRBM(
-        200, order=ORDER, init=init, history_noise=history_noise, random_state=seed
+        200,
+        order=ORDER,
+        init=init,
+        history_noise=history_noise,
+        history_noise_fraction=1.0,
+        random_state=seed,
     )
     return model.set_params(**ROW_PARAMETERS[row])
 

@@ -206,7 +206,7 @@ def imputer_parameters(args):
 
 # Parameters added after fits were cached, with the value those fits had:
 # left out of the key at that value, so the earlier fits stay valid.
-_LATER_PARAMETERS = {"centering": False}
+_LATER_PARAMETERS = {"centering": False, "history_noise_fraction": 1.0}
 
 
 def _digest(estimator, leave_out=()):

@@ -38,6 +38,8 @@ __all__ = ["main"]
 DEMO_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_demo"
 # Stick figures in the demo's strip of a generated sequence.
 STRIP_FIGURES = 30
+# The model options default to the estimator's own defaults.
+_DEFAULTS = ConditionalRBM()
 # Seed windows of each style that ``fit`` saves with the model, for ``sample``.
 N_STYLE_WINDOWS = 50
 
@@ -202,9 +204,15 @@ def _add_model_options(parser, n_iter):
     parser.add_argument(
         "--history-noise",
         type=float,
-        default=0.8,
+        default=_DEFAULTS.history_noise,
         help="noise on the history during training (0 is the paper's schedule, "
         "whose fill-ins and generated styles drift for some seeds)",
+    )
+    parser.add_argument(
+        "--history-noise-fraction",
+        type=float,
+        default=_DEFAULTS.history_noise_fraction,
+        help="share of each training frame's channels whose history gets the noise",
     )
     parser.add_argument(
         "--n-iter", type=int, default=n_iter, help="training epochs (the paper: 4000)"
@@ -221,6 +229,7 @@ def _model_from_args(args):
         order=args.order,
         n_iter=args.n_iter,
         history_noise=args.history_noise,
+        history_noise_fraction=args.history_noise_fraction,
         random_state=args.seed,
         verbose=max(1, args.n_iter // 10),
     )

@@ -24,7 +24,7 @@ from ._crbm_math import (
     CDWorkspace,
     CRBMParameters,
     MomentumUpdate,
-    add_normal_noise,
+    add_history_noise,
     cd_gradients,
     shift_centred,
 )
@@ -171,6 +171,14 @@ class ConditionalRBM(BaseCRBM):
         (two encodings, 300 and 1000 frames,
         ``benchmarks/generation_seeds.py``), at the price of a larger
         one-step prediction error.
+    history_noise_fraction : float in (0, 1], default=0.5
+        Probability with which each channel of each training frame's history
+        gets the ``history_noise`` (drawn anew for every frame and channel,
+        the same at every lag of that channel); the other channels' past
+        stays clean.  ``1`` noises every channel.  A model that has seen
+        clean and noisy channels side by side learns to trust the clean
+        ones, which is what filling in gives it: the observed channels' past
+        is exact, only the filled ones' is its own.
     n_iter : int, default=1000
         Number of epochs (passes over the trainable frames).  On CMU subject
         35 (2813 frames, 62 channels) an epoch of 200 hidden units takes about
@@ -320,6 +328,7 @@ class ConditionalRBM(BaseCRBM):
         "visible_variance": [StrOptions({"unit", "learned", "residual"})],
         "init": [StrOptions({"random", "autoregressive"})],
         "centering": ["boolean"],
+        "history_noise_fraction": [Interval(Real, 0, 1, closed="right")],
     }
 
     # Private state that a failed fit must forget with the fitted attributes:
@@ -350,7 +359,8 @@ class ConditionalRBM(BaseCRBM):
         cd_steps=1,
         batch_size=100,
         batching="balanced",
-        history_noise=0.8,
+        history_noise=1.0,
+        history_noise_fraction=0.5,
         n_iter=1000,
         ais_steps=50,
         ais_chains=2,
@@ -377,6 +387,7 @@ class ConditionalRBM(BaseCRBM):
         self.batch_size = batch_size
         self.batching = batching
         self.history_noise = history_noise
+        self.history_noise_fraction = history_noise_fraction
         self.n_iter = n_iter
         self.ais_steps = ais_steps
         self.ais_chains = ais_chains
@@ -400,6 +411,7 @@ class ConditionalRBM(BaseCRBM):
         batch_size=100,
         batching="shuffled",
         history_noise=0.0,
+        history_noise_fraction=1.0,
         visible_variance="unit",
         centering=False,
         n_iter=4000,
@@ -674,10 +686,12 @@ class ConditionalRBM(BaseCRBM):
                     X, batch, n_lags, out=workspace.history[:n, ...]
                 )
                 if self.history_noise:
-                    add_normal_noise(
+                    add_history_noise(
                         math_rng,
                         batch_history,
                         self.history_noise,
+                        X.shape[1],
+                        self.history_noise_fraction,
                         noise_buffer[:n, ...],
                     )
                 _, error = cd_gradients(

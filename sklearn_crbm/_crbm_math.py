@@ -146,6 +146,14 @@ def add_normal_noise(rng, array, scale, work=None):
     from a numpy Generator), else in ``array``'s dtype.  ``work``, scratch
     of ``array``'s shape, receives them if it has that dtype.
     """
+    noise = _noise_draws(rng, array, work)
+    noise *= scale
+    array += noise
+    return array
+
+
+def _noise_draws(rng, array, work):
+    """Standard normals of ``array``'s shape, in the dtype add_normal_noise uses."""
     dtype = array.dtype
     if isinstance(rng, np.random.Generator) and math.prod(array.shape) >= (
         _MIN_BIT_DRAWS
@@ -153,10 +161,35 @@ def add_normal_noise(rng, array, scale, work=None):
         dtype = np.float32
     if work is not None and work.dtype != dtype:
         work = None
-    noise = standard_normal(rng, array.shape, dtype, work)
-    noise *= scale
-    array += noise
-    return array
+    return standard_normal(rng, array.shape, dtype, work)
+
+
+def add_history_noise(rng, history, scale, n_features, fraction=1.0, work=None):
+    """Noise on a random ``fraction`` of the channels of each frame's history.
+
+    ``history`` (shape ``(n, n_lags * n_features)``, lag blocks of
+    ``n_features`` channels) gets ``scale * N(0, 1)`` added in place where
+    channel ``i`` of frame ``k`` is drawn to be noised, with probability
+    ``fraction``, independently for every frame and channel, and then at
+    every lag of that channel; the other channels' past stays clean.  The
+    noised channels are drawn first (one uniform per frame and channel),
+    then the noise as :func:`add_normal_noise` draws it; ``fraction=1``
+    draws no uniforms and is :func:`add_normal_noise` itself.  Returns
+    ``history``.
+    """
+    if fraction >= 1:
+        return add_normal_noise(rng, history, scale, work)
+    ops = array_ops(history)
+    xp = np if ops is np else ops.xp
+    n = history.shape[0]
+    draws = uniform(rng, (n, n_features), history.dtype)
+    noise = _noise_draws(rng, history, work)
+    noised = ops.astype(ops.less(draws, fraction), noise.dtype)
+    noised *= scale
+    blocks = xp.reshape(noise, (n, -1, n_features))
+    blocks *= xp.reshape(noised, (n, 1, n_features))
+    history += xp.reshape(blocks, history.shape)
+    return history
 
 
 def logistic(activation, out=None):

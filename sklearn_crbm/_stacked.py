@@ -64,6 +64,10 @@ class StackedCRBM(BaseCRBM):
         for every layer, or one per layer, bottom first.  Higher layers see
         hidden probabilities in [0, 1], whose spread is smaller than that of
         standardised data, so they call for smaller values.
+    history_noise_fraction : float in (0, 1], default=1.0
+        Probability with which each channel of a training frame's history
+        gets that noise, in every layer (see :class:`ConditionalRBM`, whose
+        default is 0.5); ``1`` noises every channel.
     n_iter : int, default=200
         Epochs per layer.
     random_state : int, RandomState instance or None, default=None
@@ -128,6 +132,7 @@ class StackedCRBM(BaseCRBM):
         **BaseCRBM._parameter_constraints,
         "n_components": [Interval(Integral, 1, None, closed="left"), "array-like"],
         "history_noise": [Interval(Real, 0, None, closed="left"), "array-like"],
+        "history_noise_fraction": [Interval(Real, 0, 1, closed="right")],
     }
 
     def __init__(
@@ -144,6 +149,7 @@ class StackedCRBM(BaseCRBM):
         batch_size=100,
         batching="balanced",
         history_noise=0.0,
+        history_noise_fraction=1.0,
         n_iter=200,
         random_state=None,
         verbose=0,
@@ -159,6 +165,7 @@ class StackedCRBM(BaseCRBM):
         self.batch_size = batch_size
         self.batching = batching
         self.history_noise = history_noise
+        self.history_noise_fraction = history_noise_fraction
         self.n_iter = n_iter
         self.random_state = random_state
         self.verbose = verbose
@@ -218,6 +225,7 @@ class StackedCRBM(BaseCRBM):
             batch_size=self.batch_size,
             batching=self.batching,
             history_noise=history_noise,
+            history_noise_fraction=self.history_noise_fraction,
             n_iter=self.n_iter,
             random_state=seed,
             verbose=self.verbose,

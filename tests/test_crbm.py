@@ -236,15 +236,16 @@ def test_training_on_crbm_data_raises_exact_likelihood():
 
 # ------------------------------------------------------------ CD update
 @pytest.mark.parametrize(
-    "n_components, n_features, n_frames, history_noise",
+    "n_components, n_features, n_frames, history_noise, fraction",
     [
-        (5, 4, 15, 0.0),  # few draws: numpy's float64 uniforms
+        (5, 4, 15, 0.0, 1.0),  # few draws: numpy's float64 uniforms
         # >= 4096 draws per minibatch: 23-bit uniforms, float32 Box-Muller noise
-        (40, 12, 60, 0.5),
+        (40, 12, 60, 0.5, 1.0),
+        (40, 12, 60, 0.5, 0.5),  # noise on about half the channels of each frame
     ],
 )
 def test_one_cd1_update_equals_paper_equations(
-    n_components, n_features, n_frames, history_noise
+    n_components, n_features, n_frames, history_noise, fraction
 ):
     order = 3
     X, ids = make_oscillations(
@@ -256,6 +257,7 @@ def test_one_cd1_update_equals_paper_equations(
         batch_size=1000,
         n_iter=1,
         history_noise=history_noise,
+        history_noise_fraction=fraction,
         random_state=0,
     )
     model.partial_fit(X, sequence_ids=ids)  # epoch 1; the update we check is epoch 2
@@ -269,8 +271,12 @@ def test_one_cd1_update_equals_paper_equations(
     (batch,) = balanced_batches(frames, 1000, rng)
     shape = (len(batch), n_components)
     noise = np.zeros((len(batch), order * n_features))
+    noised = np.ones((len(batch), n_features))  # which channels get noise
+    if history_noise and fraction < 1:
+        noised = rng.random(noised.shape) < fraction
     if history_noise:
         noise = history_noise * standard_normal(rng, noise.shape, np.float32)
+        noise = noise * np.tile(noised, order)
     if len(batch) * n_components >= 4096:  # 2u - 1 from 23 random bits
         uniform_draws = (uniform(rng, shape, np.float32, symmetric=True) + 1.0) / 2
     else:

@@ -18,6 +18,7 @@ from sklearn_crbm._crbm_math import (
     CRBMParameters,
     HiddenSampler,
     MomentumUpdate,
+    add_history_noise,
     add_normal_noise,
     cd_gradients,
     dynamic_biases,
@@ -365,3 +366,32 @@ def test_gibbs_frames_keep_observed_values_and_draw_as_before():
     current += visible_bias
     current[mask] = visible[mask]
     assert_allclose(frames, current, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+@pytest.mark.parametrize("n", [4, 100])
+def test_history_noise_on_a_fraction_of_the_channels(dtype, n):
+    """Each frame's channel is noised at every lag or at none, drawn first."""
+    n_features, n_lags, fraction = 31, 3, 0.4
+    base = np.linspace(-1, 1, n * n_lags * n_features).reshape(n, -1).astype(dtype)
+    noisy = add_history_noise(
+        np.random.default_rng(5), base.copy(), 0.3, n_features, fraction
+    )
+    rng = np.random.default_rng(5)
+    noised = uniform(rng, (n, n_features), dtype) < fraction
+    added = noisy - base
+    expected = add_normal_noise(rng, np.zeros_like(base), 0.3) * np.tile(noised, n_lags)
+    assert_allclose(added, expected, rtol=1e-5, atol=1e-6)
+    blocks = added.reshape(n, n_lags, n_features) != 0
+    assert_array_equal(blocks, np.broadcast_to(noised[:, None], blocks.shape))
+    assert_array_equal(
+        add_history_noise(np.random.default_rng(5), base.copy(), 0.3, n_features, 1.0),
+        add_normal_noise(np.random.default_rng(5), base.copy(), 0.3),
+    )
+
+
+def test_history_noise_fraction_is_the_share_of_noised_channels():
+    history = np.zeros((2000, 3 * 10))
+    add_history_noise(np.random.default_rng(0), history, 1.0, 10, 0.3)
+    share = np.mean(history[:, :10] != 0)
+    assert abs(share - 0.3) < 0.01  # 20,000 Bernoulli(0.3): sd 0.0032

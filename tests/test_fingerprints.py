@@ -39,7 +39,8 @@ X_MISSING[15:, :2] = np.nan  # channels lost half-way through
 X_MISSING[25:28] = np.nan  # wholly missing frames
 
 # history_noise is spelled out: its default changed (issue 15) after the
-# fingerprints were computed with clean histories.
+# fingerprints were computed with clean histories; so is
+# history_noise_fraction where there is noise (its default changed later).
 MODELS = {
     "order2": dict(n_components=8, order=2, history_noise=0.0),
     "order3_hidden1": dict(n_components=6, order=3, hidden_order=1, history_noise=0.0),
@@ -49,6 +50,7 @@ MODELS = {
         n_components=7,
         order=2,
         history_noise=0.5,
+        history_noise_fraction=1.0,
         batching="shuffled",
         cd_steps=2,
         batch_size=37,
@@ -109,7 +111,14 @@ def _crbm_results():
 def _imputer_results():
     out = {}
     for dtype in ("float64", "float32"):
-        model = ConditionalRBM(8, order=2, n_iter=10, history_noise=0.3, random_state=0)
+        model = ConditionalRBM(
+            8,
+            order=2,
+            n_iter=10,
+            history_noise=0.3,
+            history_noise_fraction=1.0,
+            random_state=0,
+        )
         train = X[IDS < 3].astype(dtype)
         for particles in (1, 3):
             imputer = CRBMImputer(

@@ -296,7 +296,12 @@ def test_feature_names_out():
 def test_history_noise_shrinks_the_directed_weights_and_only_affects_training():
     X, ids = make_oscillations(n_sequences=6, n_frames=60, n_features=5, random_state=0)
     params = dict(
-        n_components=8, order=2, n_iter=100, learning_rate=1e-2, random_state=0
+        n_components=8,
+        order=2,
+        n_iter=100,
+        learning_rate=1e-2,
+        history_noise_fraction=1.0,  # every channel of the past is noisy
+        random_state=0,
     )
     clean = ConditionalRBM(history_noise=0.0, **params).fit(X, sequence_ids=ids)
     noisy = ConditionalRBM(history_noise=1.0, **params).fit(X, sequence_ids=ids)
@@ -316,8 +321,10 @@ def test_history_noise_shrinks_the_directed_weights_and_only_affects_training():
 
 def test_stack_passes_history_noise_to_every_layer():
     X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
-    stack = small_stack(history_noise=0.3).fit(X, sequence_ids=ids)
+    stack = small_stack(history_noise=0.3, history_noise_fraction=0.7)
+    stack.fit(X, sequence_ids=ids)
     assert [layer.history_noise for layer in stack.layers_] == [0.3, 0.3]
+    assert [layer.history_noise_fraction for layer in stack.layers_] == [0.7, 0.7]
     per_layer = small_stack(history_noise=[0.5, 0.1]).fit(X, sequence_ids=ids)
     assert [layer.history_noise for layer in per_layer.layers_] == [0.5, 0.1]
     with pytest.raises(ValueError, match="one such number per layer"):
