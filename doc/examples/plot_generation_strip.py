@@ -9,8 +9,8 @@ frames of walking it walks, seeded with three frames of jogging it jogs.  This
 example does the same and draws every 4th generated frame side by side, as in
 the paper's Fig. 3, with the real trial the seed came from for comparison.
 
-The model is trained with ``history_noise=0.8``: noise on the past frames
-that feed the directed connections, which keeps long generated sequences in
+The model is trained with the default ``history_noise``: noise on the past
+frames that feed the directed connections, which keeps long generated sequences in
 their style (``benchmarks/generation_styles.py`` measures it; with the paper's
 schedule alone, some training seeds turn every walk into a jog).  The
 generated frames go back to raw joint angles through the preprocessing's exact
@@ -65,7 +65,7 @@ print(f"{Z.shape[0]} frames of {Z.shape[1]} preprocessed channels")
 # 200 hidden units and order 3 as in the paper; about half a minute on a
 # laptop core.
 model = ConditionalRBM(
-    200, order=3, n_iter=n_iter, history_noise=0.8, random_state=0
+    200, order=3, n_iter=n_iter, random_state=0
 ).fit(Z.astype(np.float32), sequence_ids=motion.sequence_ids)
 
 # %%

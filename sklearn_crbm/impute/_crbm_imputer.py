@@ -72,7 +72,7 @@ class CRBMImputer(
         :class:`sklearn.frozen.FrozenEstimator`:
         ``CRBMImputer(FrozenEstimator(model))``.  ``None`` means
         ``ConditionalRBM()``, seeded from ``random_state`` (see there), whose
-        default ``history_noise=0.8`` trains on
+        default ``history_noise`` trains on
         noisy histories so that on-line fills do not drift (see Notes; with
         :meth:`ConditionalRBM.paper_schedule` the filled upper body of a
         walk drifts for some training seeds).  Standardise the data first (e.g. with
