@@ -105,8 +105,8 @@ VARIANTS = {
     "particles": dict(model=ORIGINAL_MODEL, imputer=dict(PAPER_FILLIN, n_particles=10)),
     "noisy": dict(model=NOISY_MODEL, imputer=dict(PAPER_FILLIN, n_particles=1)),
     "robust": dict(model=NOISY_MODEL, imputer=dict(PAPER_FILLIN, n_particles=10)),
-    # ConditionalRBM's default noise level, which also keeps generated
-    # styles stable (generation_seeds.py)
+    # ConditionalRBM's default noise level before history_noise_fraction
+    # (on every channel, as paper_schedule's fraction of 1 keeps it)
     "noisy0.8": dict(
         model=dict(ORIGINAL_MODEL, history_noise=0.8),
         imputer=dict(PAPER_FILLIN, n_particles=1),
