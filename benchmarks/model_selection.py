@@ -186,6 +186,12 @@ def history_noise(args):
     return args.history_noise
 
 
+def history_noise_fraction(args):
+    """``history_noise_fraction``: the option if given, else the estimator's default."""
+    fraction = getattr(args, "history_noise_fraction", None)
+    return ConditionalRBM().history_noise_fraction if fraction is None else fraction
+
+
 def model_parameters(n_components, order, args):
     """The ConditionalRBM of a grid cell: the options given, defaults otherwise."""
     return dict(
@@ -193,7 +199,8 @@ def model_parameters(n_components, order, args):
         order=order,
         n_iter=args.n_iter,
         history_noise=history_noise(args),
-        centering=args.centering,
+        history_noise_fraction=history_noise_fraction(args),
+        centering=getattr(args, "centering", False),
         random_state=args.seed,
     )
 
@@ -363,6 +370,12 @@ def main(argv=None):
         type=float,
         default=None,
         help="ConditionalRBM's history_noise (default: the estimator's default)",
+    )
+    parser.add_argument(
+        "--history-noise-fraction",
+        type=float,
+        default=None,
+        help="ConditionalRBM's history_noise_fraction (default: the estimator's)",
     )
     parser.add_argument(
         "--centering", action="store_true", help="ConditionalRBM(centering=True)"
