@@ -338,6 +338,8 @@ class ConditionalRBM(BaseCRBM):
         "history_noise_fraction": [Interval(Real, 0, 1, closed="right")],
     }
 
+    _added_parameters = {"centering": False, "history_noise_fraction": 1.0}
+
     # Private state that a failed fit must forget with the fitted attributes:
     # the packed parameters (which the public ones view) and the velocities.
     _training_state = ("_parameters", "_velocity")

@@ -128,6 +128,8 @@ class StackedCRBM(BaseCRBM):
     (90, 6)
     """
 
+    _added_parameters = {"history_noise_fraction": 1.0}
+
     _parameter_constraints: dict = {
         **BaseCRBM._parameter_constraints,
         "n_components": [Interval(Integral, 1, None, closed="left"), "array-like"],

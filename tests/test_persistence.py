@@ -17,7 +17,7 @@ import pytest
 import sklearn
 import sklearn.base
 from numpy.testing import assert_array_equal
-from sklearn.base import BaseEstimator
+from sklearn.base import BaseEstimator, clone
 from sklearn.exceptions import InconsistentVersionWarning
 from sklearn.pipeline import Pipeline
 
@@ -245,3 +245,35 @@ def test_whole_pipeline_under_another_version_warns_for_every_step(monkeypatch):
         "StandardScaler",
         "ConditionalRBM",
     }
+
+
+@pytest.mark.parametrize(
+    "make, added",
+    [
+        (
+            lambda: ConditionalRBM(5, order=2, n_iter=3, random_state=0),
+            {"centering": False, "history_noise_fraction": 1.0},
+        ),
+        (
+            lambda: StackedCRBM((5, 4), order=2, n_iter=3, random_state=0),
+            {"history_noise_fraction": 1.0},
+        ),
+    ],
+)
+def test_pickles_from_before_a_parameter_was_added_still_work(make, added):
+    """A pickle without a later parameter loads with the value it was trained under."""
+    X, ids = make_oscillations(n_sequences=3, n_frames=30, random_state=0)
+    model = make().fit(X, sequence_ids=ids)
+    state = model.__getstate__()
+    for name in added:
+        del state[name]  # as an earlier release wrote it
+    old = type(model).__new__(type(model))
+    old.__setstate__(state)
+    for name, value in added.items():
+        assert old.get_params()[name] == value
+    assert_array_equal(
+        old.transform(X, sequence_ids=ids), model.transform(X, sequence_ids=ids)
+    )
+    clone(old).fit(X, sequence_ids=ids)
+    if hasattr(old, "partial_fit"):
+        old.partial_fit(X, sequence_ids=ids)

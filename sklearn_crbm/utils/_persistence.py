@@ -38,6 +38,11 @@ class VersionedPickleMixin:
     'InconsistentVersionWarning'
     """
 
+    # Parameters added after models were first saved, with the value under
+    # which a model pickled before them was trained: set on loading when the
+    # pickle lacks them, so get_params, clone and training keep working.
+    _added_parameters: dict = {}
+
     def __getstate__(self):
         state = super().__getstate__()
         return dict(state, _sklearn_version=sklearn.__version__)
@@ -53,4 +58,6 @@ class VersionedPickleMixin:
                     original_sklearn_version=pickled_version,
                 )
             )
+        for name, value in self._added_parameters.items():
+            state.setdefault(name, value)
         super().__setstate__(state)
