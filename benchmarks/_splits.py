@@ -15,6 +15,7 @@ import joblib
 import numpy as np
 import sklearn
 
+from sklearn_crbm import ConditionalRBM
 from sklearn_crbm.datasets import load_cmu35
 from sklearn_crbm.model_selection import make_fillin_cases
 from sklearn_crbm.preprocessing import make_motion_preprocessor
@@ -83,13 +84,14 @@ EVERY_CHANNEL_NOISE = dict(history_noise=0.8, history_noise_fraction=1.0)
 _TRAINING_PARAMETERS = (
     "n_components order hidden_order visible_type visible_variance learning_rate "
     "momentum momentum_delay weight_decay cd_steps batch_size batching "
-    "history_noise history_noise_fraction n_iter random_state"
+    "history_noise n_iter random_state"
 ).split()
 
 
-# Training parameters added later, with the value the fits cached before had:
-# in the key only when they differ from it.
-_LATER_PARAMETERS = {"init": "random", "centering": False}
+# Training parameters added later, with the value the fits cached before had
+# (the estimator's record of them, and init): in the key only when they
+# differ from it.
+_LATER_PARAMETERS = {"init": "random", **ConditionalRBM._added_parameters}
 
 # The code a fit runs: a change to any of these (e.g. a new random stream)
 # changes the fitted models, so their text is part of the key too.

@@ -211,9 +211,10 @@ def imputer_parameters(args):
     return paper if args.paper_fillin else {}
 
 
-# Parameters added after fits were cached, with the value those fits had:
-# left out of the key at that value, so the earlier fits stay valid.
-_LATER_PARAMETERS = {"centering": False, "history_noise_fraction": 1.0}
+# Parameters added after fits were cached, with the value those fits had
+# (the estimator's record of them): left out of the key at that value, so
+# the earlier fits stay valid.
+_LATER_PARAMETERS = ConditionalRBM._added_parameters
 
 
 def _digest(estimator, leave_out=()):

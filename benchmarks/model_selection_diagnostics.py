@@ -77,6 +77,12 @@ from sklearn_crbm.utils._sequences import check_sequence_ids
 DIAGNOSTICS = RESULTS / "model_selection_diagnostics"
 
 
+# Columns several tables share: the configuration and the fill-in errors.
+CONFIG = ("config", "hidden x order", "s")
+FILLIN_PARTS = [("leg", "fill-in leg", ".3f"), ("upper", "fill-in upper", ".3f")]
+FILLIN = ("fillin", "fill-in", ".3f")
+
+
 def _args_for(args, seed=None):
     return argparse.Namespace(
         **{
@@ -138,10 +144,9 @@ def breakdown(args):
         rows,
         [
             ("fold", "fold", "d"),
-            ("config", "hidden x order", "s"),
+            CONFIG,
             ("score", "score", ".3f"),
-            ("leg", "fill-in leg", ".3f"),
-            ("upper", "fill-in upper", ".3f"),
+            *FILLIN_PARTS,
             ("fillin", "fill-in mean", ".3f"),
             ("generation", "generation", ".3f"),
         ],
@@ -183,6 +188,13 @@ def breakdown(args):
         title="Spearman(score, -error)",
     )
     return dict(rows=rows, correlations=correlations)
+
+
+def _print_fold_means(rows, columns, title):
+    """Print the rows averaged over folds (one per configuration); return them."""
+    table = _mean_over_folds(rows)
+    print_table(table, columns, title=title)
+    return table
 
 
 def _mean_over_folds(rows):
@@ -307,7 +319,7 @@ def summarise_fillin(args, results):
     print_table(
         rows,
         [
-            ("config", "hidden x order", "s"),
+            CONFIG,
             ("score", "score", ".3f"),
             ("single", "fill-in, benchmark's draw", ".3f"),
             ("per_draw", f"mean of {args.draws} draws' errors", ".3f"),
@@ -391,7 +403,7 @@ def ais_accuracy(args):
         rows,
         [
             ("fold", "fold", "d"),
-            ("config", "hidden x order", "s"),
+            CONFIG,
             ("score", "score (default AIS)", ".3f"),
             ("default_raise", "its RAISE", ".3f"),
             ("long", f"AIS {args.long_steps} x {args.long_chains}", ".3f"),
@@ -545,16 +557,14 @@ def conditional(args):
                     f"{row['upper body cond']:.3f}, joint {row['left leg joint']:.3f}",
                     flush=True,
                 )
-    table = _mean_over_folds(rows)
-    print_table(
-        table,
+    table = _print_fold_means(
+        rows,
         [
-            ("config", "hidden x order", "s"),
+            CONFIG,
             ("left leg joint", "log p(x_t | past)", ".3f"),
             ("left leg cond", "log p(leg | rest, past)", ".3f"),
             ("upper body cond", "log p(upper | rest, past)", ".3f"),
-            ("leg", "fill-in leg", ".3f"),
-            ("upper", "fill-in upper", ".3f"),
+            *FILLIN_PARTS,
         ],
         title="held-out log-likelihoods of the erased frames (nats/frame)",
     )
@@ -656,16 +666,15 @@ def spread(args):
                     f"||x - m||^2 {error:.2f}, spread {mix:.2f}, ||x - c_hat||^2 {ar:.2f}",
                     flush=True,
                 )
-    table = _mean_over_folds(rows)
-    print_table(
-        table,
+    table = _print_fold_means(
+        rows,
         [
-            ("config", "hidden x order", "s"),
+            CONFIG,
             ("score", "score", ".3f"),
             ("error", "||x - E[x|past]||^2", ".2f"),
             ("spread", "E||mu(h) - E[x|past]||^2", ".2f"),
             ("ar_error", "||x - c_hat||^2", ".2f"),
-            ("fillin", "fill-in", ".3f"),
+            FILLIN,
         ],
         title="the model's frame given the clean past (sums over 62 channels)",
     )
@@ -845,17 +854,15 @@ def training(args):
                     f"{row['leg']:.3f} / {row['upper']:.3f}",
                     flush=True,
                 )
-    table = _mean_over_folds(rows)
-    print_table(
-        table,
+    table = _print_fold_means(
+        rows,
         [
-            ("config", "hidden x order", "s"),
+            CONFIG,
             ("score", "score", ".3f"),
             ("error", "||x - E[x|past]||^2", ".2f"),
             ("spread", "E||mu(h) - E[x|past]||^2", ".2f"),
-            ("leg", "fill-in leg", ".3f"),
-            ("upper", "fill-in upper", ".3f"),
-            ("fillin", "fill-in", ".3f"),
+            *FILLIN_PARTS,
+            FILLIN,
         ],
         title=f"training variant {args.variant!r}, last {args.fraction:g} of "
         f"{args.n_iter} epochs, history_noise {args.history_noise:g}",
@@ -900,14 +907,13 @@ def prediction(args):
                         fillin=fill(r),
                     )
                 )
-    table = _mean_over_folds(rows)
-    print_table(
-        table,
+    table = _print_fold_means(
+        rows,
         [
-            ("config", "hidden x order", "s"),
+            CONFIG,
             ("score", "score", ".3f"),
             ("prediction", "-one-step MSE", ".4f"),
-            ("fillin", "fill-in", ".3f"),
+            FILLIN,
         ],
         title=f"one-step prediction, history_noise {args.history_noise:g}",
     )

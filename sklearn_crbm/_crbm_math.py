@@ -994,7 +994,7 @@ def cd_gradients(
     else:
         out.log_visible_variance[...] = 0
     if centered:
-        _centre_statistics(params, visible_bias, delta, d, scale, out)
+        _centre_statistics(params, std, visible_bias, delta, d, scale, out)
     # the scale goes into the small factors: [v; -v_recon] and delta; W's
     # statistics are those of v / s
     visible_scale = scale if std is None else scale / std
@@ -1014,15 +1014,15 @@ def cd_gradients(
     return out, squared_error
 
 
-def _centre_statistics(params, visible_bias, delta, d, scale, out):
+def _centre_statistics(params, std, visible_bias, delta, d, scale, out):
     """The chain-rule terms of the centred coordinates (see cd_gradients).
 
     Changes the visible part of ``delta`` (not yet scaled) and, with learned
-    variances, the statistic of ``log s^2`` in ``out``.
+    variances, the statistic of ``log s^2`` in ``out``; ``std`` is
+    ``params.visible_std``.
     """
     ops = params.ops
     back = ops.matmul(delta[:, d:], params.weights)  # W.T dh, frame by frame
-    std = params.visible_std
     if params.learned_variance:
         term = ops.sum(visible_bias * back, axis=0) / (2 * std)
         out.log_visible_variance[...] = out.log_visible_variance + scale * term
