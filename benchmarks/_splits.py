@@ -74,9 +74,14 @@ class Split:
         )
 
 
-# The noise of ConditionalRBM's defaults before history_noise_fraction (on
-# every channel of the history): the earlier tables' models spell it out.
-EVERY_CHANNEL_NOISE = dict(history_noise=0.8, history_noise_fraction=1.0)
+# ConditionalRBM's defaults before history_noise_fraction and average_fraction
+# (noise on every channel of the history, the last epoch's parameters kept):
+# the earlier tables' models spell them out.
+EARLIER_DEFAULTS = dict(
+    history_noise=0.8, history_noise_fraction=1.0, average_fraction=0.0
+)
+# The defaults just before average_fraction.
+UNAVERAGED = dict(average_fraction=0.0)
 
 # What a trained model depends on: the cache key leaves out parameters that
 # only affect inference (and any added later), so changes to inference reuse

@@ -13,9 +13,11 @@ Protocol (the paper's §4.4, as ``paper_fillin.py``, with a second split):
 - CRBM models (``--models``), one per training seed: ``default`` is
   ``CRBMImputer(ConditionalRBM(200, order=3, n_iter=1000))`` with every
   other parameter of both at its default, ``paper`` the same with
-  ``ConditionalRBM.paper_schedule(n_iter=1000)``, ``every-channel`` the
-  defaults before ``history_noise_fraction`` (``history_noise=0.8`` on
-  every channel: ``_splits.EVERY_CHANNEL_NOISE``), ``ar-init`` that
+  ``ConditionalRBM.paper_schedule(n_iter=1000)``, ``unaveraged`` the
+  defaults before ``average_fraction`` (the last epoch's parameters:
+  ``_splits.UNAVERAGED``), ``every-channel`` the defaults before
+  ``history_noise_fraction`` (``history_noise=0.8`` on every channel, not
+  averaged: ``_splits.EARLIER_DEFAULTS``), ``ar-init`` that
   with ``init="autoregressive"`` and ``ar-init-learned`` that with
   ``visible_variance="learned"`` and ``cd_steps=5`` (both with
   ``--ar-history-noise`` if given), ``centred`` ``every-channel`` with
@@ -54,8 +56,9 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 from _splits import (  # noqa: E402
     CELLS,
-    EVERY_CHANNEL_NOISE,
+    EARLIER_DEFAULTS,
     SPLITS,
+    UNAVERAGED,
     Split,
     cached_model,
 )
@@ -88,6 +91,7 @@ DENSITY = dict(
     centering=True,
     history_noise=0.0,
     n_iter=60,
+    average_fraction=0.0,
 )
 
 
@@ -110,7 +114,9 @@ def crbm_model(name, seed, n_iter, ar_history_noise=None):
         return ConditionalRBM(random_state=seed)
     model = ConditionalRBM(200, order=3, n_iter=n_iter, random_state=seed)
     if name in ("every-channel", "centred") or name.startswith("ar-init"):
-        model.set_params(**EVERY_CHANNEL_NOISE)  # measured at the defaults of then
+        model.set_params(**EARLIER_DEFAULTS)  # measured at the defaults of then
+    if name == "unaveraged":
+        model.set_params(**UNAVERAGED)
     if name.startswith("ar-init"):
         model.set_params(init="autoregressive")
         if ar_history_noise is not None:
@@ -162,6 +168,7 @@ def main(argv=None):
         choices=[
             "default",
             "paper",
+            "unaveraged",
             "ar-init",
             "ar-init-learned",
             "bare",

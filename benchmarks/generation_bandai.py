@@ -109,6 +109,7 @@ def run(walks, *, n_iter, seed, n_sequences, n_frames, encoding):
         n_iter=n_iter,
         history_noise=0.8,
         history_noise_fraction=1.0,
+        average_fraction=0.0,
         random_state=seed,
     )
     start = time.perf_counter()

@@ -7,9 +7,11 @@ Protocol:
   other parameter at its default, ``paper``:
   ``ConditionalRBM.paper_schedule``; ``bare``: ``ConditionalRBM()``, every
   parameter but ``random_state`` at its default, ``--n-iter`` ignored;
-  ``every-channel``: ``default`` with the noise of the defaults before
-  ``history_noise_fraction``, ``history_noise=0.8`` on every channel;
-  ``centred``: that with ``centering=True``),
+  ``unaveraged``: ``default`` with ``average_fraction=0`` (the last
+  epoch's parameters, the defaults before averaging); ``every-channel``:
+  ``default`` with the noise of the defaults before
+  ``history_noise_fraction``, ``history_noise=0.8`` on every channel, not
+  averaged; ``centred``: that with ``centering=True``),
   cached with the other generation benchmarks;
 - per training seed, 6 walk-seeded and 6 jog-seeded sequences of 1000
   frames (seeds of ``order`` real frames drawn as in
@@ -41,7 +43,7 @@ import tempfile  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
-from _splits import EVERY_CHANNEL_NOISE, cached_model  # noqa: E402
+from _splits import EARLIER_DEFAULTS, UNAVERAGED, cached_model  # noqa: E402
 from generation_styles import Motion, draw_seeds, judge  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
@@ -62,7 +64,9 @@ def model(name, seed, n_iter, n_components=200):
         return ConditionalRBM(random_state=seed)
     default = ConditionalRBM(n_components, order=3, n_iter=n_iter, random_state=seed)
     if name in ("every-channel", "centred"):
-        default.set_params(**EVERY_CHANNEL_NOISE)  # the defaults of then
+        default.set_params(**EARLIER_DEFAULTS)  # the defaults of then
+    if name == "unaveraged":
+        default.set_params(**UNAVERAGED)
     return default.set_params(centering=name == "centred")
 
 
@@ -129,7 +133,7 @@ def main(argv=None):
         "--models",
         nargs="+",
         default=["default", "paper"],
-        choices=["default", "paper", "bare", "centred", "every-channel"],
+        choices=["default", "paper", "bare", "unaveraged", "centred", "every-channel"],
     )
     parser.add_argument("--n-iter", type=int, default=1000)
     parser.add_argument(

@@ -90,7 +90,7 @@ CMU_LEGS = ("lfemur", "rfemur", "ltibia", "rtibia")  # hips and knees
 MIT_LEGS = ("lhip", "rhip", "lknee", "rknee")
 BLOW_UP = 10.0
 VARIANTS = {
-    "faithful": {},
+    "faithful": {"history_noise": 0.0},
     "noisy-history": {"history_noise": None},  # filled from --history-noise
 }
 
@@ -319,9 +319,10 @@ def train_crbm(cache_dir, Z, ids, seed, n_iter, params):
 
 
 def variant_params(name, history_noise):
-    params = dict(VARIANTS[name])
-    if "history_noise" in params:  # on every channel, as when these were measured
-        params.update(history_noise=history_noise, history_noise_fraction=1.0)
+    # on every channel and unaveraged, as when these were measured
+    params = dict(VARIANTS[name], history_noise_fraction=1.0, average_fraction=0.0)
+    if params["history_noise"] is None:
+        params["history_noise"] = history_noise
     return params
 
 

@@ -154,6 +154,7 @@ def row_model(row, seed, init="random", history_noise=0.8):
         init=init,
         history_noise=history_noise,
         history_noise_fraction=1.0,
+        average_fraction=0.0,
         random_state=seed,
     )
     return model.set_params(**ROW_PARAMETERS[row])

@@ -179,17 +179,14 @@ def ar_log_likelihood(data, order):
     return float(np.mean(log_density.sum(axis=1)))
 
 
+def option_or_default(args, name):
+    """A ConditionalRBM parameter of the grid: the option if given, else its default."""
+    value = getattr(args, name, None)
+    return getattr(ConditionalRBM(), name) if value is None else value
+
+
 def history_noise(args):
-    """The ``history_noise`` of the grid: the option, else the estimator's default."""
-    if args.history_noise is None:
-        return ConditionalRBM().history_noise
-    return args.history_noise
-
-
-def history_noise_fraction(args):
-    """``history_noise_fraction``: the option if given, else the estimator's default."""
-    fraction = getattr(args, "history_noise_fraction", None)
-    return ConditionalRBM().history_noise_fraction if fraction is None else fraction
+    return option_or_default(args, "history_noise")
 
 
 def model_parameters(n_components, order, args):
@@ -199,7 +196,8 @@ def model_parameters(n_components, order, args):
         order=order,
         n_iter=args.n_iter,
         history_noise=history_noise(args),
-        history_noise_fraction=history_noise_fraction(args),
+        history_noise_fraction=option_or_default(args, "history_noise_fraction"),
+        average_fraction=option_or_default(args, "average_fraction"),
         centering=getattr(args, "centering", False),
         random_state=args.seed,
     )
@@ -294,9 +292,9 @@ def verify_search(args, results):
         (np.flatnonzero(fold_of_frame != k), np.flatnonzero(fold_of_frame == k))
         for k in args.folds
     ]
-    model = ConditionalRBM(
-        n_iter=args.n_iter, history_noise=history_noise(args), random_state=args.seed
-    )
+    grid_cell = model_parameters(None, None, args)
+    del grid_cell["n_components"], grid_cell["order"]  # the search's parameters
+    model = ConditionalRBM(**grid_cell)
     pipeline = Pipeline(
         make_motion_preprocessor(cmu.skeleton).steps + [("crbm", model)]
     )
@@ -377,6 +375,12 @@ def main(argv=None):
         type=float,
         default=None,
         help="ConditionalRBM's history_noise_fraction (default: the estimator's)",
+    )
+    parser.add_argument(
+        "--average-fraction",
+        type=float,
+        default=None,
+        help="ConditionalRBM's average_fraction (default: the estimator's)",
     )
     parser.add_argument(
         "--centering", action="store_true", help="ConditionalRBM(centering=True)"

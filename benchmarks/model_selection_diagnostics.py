@@ -463,6 +463,7 @@ def epochs(args):
                     n_iter=checkpoints[0],
                     history_noise=args.history_noise,
                     history_noise_fraction=args.history_noise_fraction,
+                    average_fraction=args.average_fraction,
                     random_state=args.seed,
                 )
                 model.fit(data["Z_train"], sequence_ids=data["train_ids"])
@@ -786,6 +787,7 @@ def _train_variant(data, size, order, fold, args):
         n_iter=args.n_iter - n_last,
         history_noise=args.history_noise,
         history_noise_fraction=args.history_noise_fraction,
+        average_fraction=args.average_fraction,
         random_state=args.seed,
     )
     X, ids = data["Z_train"], data["train_ids"]
@@ -951,8 +953,10 @@ def main(argv=None):
     parser.add_argument("--n-iter", type=int, default=500)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--history-noise", type=float, default=0.8)
-    # the measurements of benchmarks/README.md: noise on every channel
+    # the measurements of benchmarks/README.md: noise on every channel, the
+    # last epoch's parameters
     parser.add_argument("--history-noise-fraction", type=float, default=1.0)
+    parser.add_argument("--average-fraction", type=float, default=0.0)
     parser.add_argument("--paper-fillin", action="store_true")
     parser.add_argument("--draws", type=int, default=8)
     parser.add_argument("--fill-seed", type=int, default=1)

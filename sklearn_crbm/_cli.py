@@ -215,6 +215,13 @@ def _add_model_options(parser, n_iter):
         help="share of each training frame's channels whose history gets the noise",
     )
     parser.add_argument(
+        "--average-fraction",
+        type=float,
+        default=_DEFAULTS.average_fraction,
+        help="final share of the epochs whose parameters are averaged (0: keep "
+        "the last epoch's, the paper's schedule)",
+    )
+    parser.add_argument(
         "--n-iter", type=int, default=n_iter, help="training epochs (the paper: 4000)"
     )
     parser.add_argument(
@@ -230,6 +237,7 @@ def _model_from_args(args):
         n_iter=args.n_iter,
         history_noise=args.history_noise,
         history_noise_fraction=args.history_noise_fraction,
+        average_fraction=args.average_fraction,
         random_state=args.seed,
         verbose=max(1, args.n_iter // 10),
     )

@@ -846,6 +846,34 @@ class MomentumUpdate:
         parameters += velocity
 
 
+class ParameterAverage:
+    """Running mean of a CRBM's parameters, one sample per epoch.
+
+    Polyak-Ruppert averaging: with a constant learning rate the CD iterates
+    keep wandering around the region they have reached, and their mean is a
+    steadier model than any one of them.
+
+    Attributes
+    ----------
+    mean : CRBMParameters or None
+        The mean of the parameters added so far (None before the first).
+    count : int
+        How many were added.
+    """
+
+    def __init__(self):
+        self.mean = None
+        self.count = 0
+
+    def add(self, params):
+        """Fold ``params`` (a :class:`CRBMParameters`) into the mean."""
+        self.count += 1
+        if self.mean is None:
+            self.mean = params.copy()
+        else:
+            self.mean.flat += (params.flat - self.mean.flat) / self.count
+
+
 def cd_gradients(
     params,
     visible,

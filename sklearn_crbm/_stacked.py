@@ -68,6 +68,11 @@ class StackedCRBM(BaseCRBM):
         Probability with which each channel of a training frame's history
         gets that noise, in every layer (see :class:`ConditionalRBM`, whose
         default is 0.5); ``1`` noises every channel.
+    average_fraction : float in [0, 1), default=0.0
+        Every layer's :meth:`~ConditionalRBM.fit` keeps the mean of its
+        parameters over the last ``ceil(average_fraction * n_iter)`` epochs
+        (see :class:`ConditionalRBM`, whose default is 0.25); ``0`` keeps
+        the last epoch's.
     n_iter : int, default=200
         Epochs per layer.
     random_state : int, RandomState instance or None, default=None
@@ -128,13 +133,14 @@ class StackedCRBM(BaseCRBM):
     (90, 6)
     """
 
-    _added_parameters = {"history_noise_fraction": 1.0}
+    _added_parameters = {"history_noise_fraction": 1.0, "average_fraction": 0.0}
 
     _parameter_constraints: dict = {
         **BaseCRBM._parameter_constraints,
         "n_components": [Interval(Integral, 1, None, closed="left"), "array-like"],
         "history_noise": [Interval(Real, 0, None, closed="left"), "array-like"],
         "history_noise_fraction": [Interval(Real, 0, 1, closed="right")],
+        "average_fraction": [Interval(Real, 0, 1, closed="left")],
     }
 
     def __init__(
@@ -152,6 +158,7 @@ class StackedCRBM(BaseCRBM):
         batching="balanced",
         history_noise=0.0,
         history_noise_fraction=1.0,
+        average_fraction=0.0,
         n_iter=200,
         random_state=None,
         verbose=0,
@@ -168,6 +175,7 @@ class StackedCRBM(BaseCRBM):
         self.batching = batching
         self.history_noise = history_noise
         self.history_noise_fraction = history_noise_fraction
+        self.average_fraction = average_fraction
         self.n_iter = n_iter
         self.random_state = random_state
         self.verbose = verbose
@@ -228,6 +236,7 @@ class StackedCRBM(BaseCRBM):
             batching=self.batching,
             history_noise=history_noise,
             history_noise_fraction=self.history_noise_fraction,
+            average_fraction=self.average_fraction,
             n_iter=self.n_iter,
             random_state=seed,
             verbose=self.verbose,

@@ -52,7 +52,7 @@ def ridge(features, targets):
 def no_training(monkeypatch):
     """Epochs that count but change nothing: fit leaves the start as it is."""
 
-    def count(self, X, frames, n_epochs):
+    def count(self, X, frames, n_epochs, n_averaged=0):
         self.n_iter_ += n_epochs
 
     monkeypatch.setattr(ConditionalRBM, "_train", count)

@@ -40,7 +40,8 @@ X_MISSING[25:28] = np.nan  # wholly missing frames
 
 # history_noise is spelled out: its default changed (issue 15) after the
 # fingerprints were computed with clean histories; so is
-# history_noise_fraction where there is noise (its default changed later).
+# history_noise_fraction where there is noise (its default changed later),
+# and average_fraction (added later with a default that averages).
 MODELS = {
     "order2": dict(n_components=8, order=2, history_noise=0.0),
     "order3_hidden1": dict(n_components=6, order=3, hidden_order=1, history_noise=0.0),
@@ -68,7 +69,9 @@ FITTED = (
 
 
 def _crbm(name, dtype, n_iter=7, **extra):
-    model = ConditionalRBM(**MODELS[name], n_iter=n_iter, random_state=0, **extra)
+    model = ConditionalRBM(
+        **MODELS[name], average_fraction=0.0, n_iter=n_iter, random_state=0, **extra
+    )
     return model.fit(X.astype(dtype), sequence_ids=IDS)
 
 
@@ -100,7 +103,13 @@ def _crbm_results():
             10, history=X[:5], n_sequences=2, sample_visibles=True, random_state=3
         )
     binary = ConditionalRBM(
-        5, order=1, visible_type="binary", n_iter=4, history_noise=0.0, random_state=0
+        5,
+        order=1,
+        visible_type="binary",
+        n_iter=4,
+        history_noise=0.0,
+        average_fraction=0.0,
+        random_state=0,
     )
     binary.fit((X > 0).astype(float), sequence_ids=IDS)
     out.update(_fitted("fit.binary.float64", binary))
@@ -117,6 +126,7 @@ def _imputer_results():
             n_iter=10,
             history_noise=0.3,
             history_noise_fraction=1.0,
+            average_fraction=0.0,
             random_state=0,
         )
         train = X[IDS < 3].astype(dtype)

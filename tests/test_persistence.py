@@ -252,11 +252,15 @@ def test_whole_pipeline_under_another_version_warns_for_every_step(monkeypatch):
     [
         (
             lambda: ConditionalRBM(5, order=2, n_iter=3, random_state=0),
-            {"centering": False, "history_noise_fraction": 1.0},
+            {
+                "centering": False,
+                "history_noise_fraction": 1.0,
+                "average_fraction": 0.0,
+            },
         ),
         (
             lambda: StackedCRBM((5, 4), order=2, n_iter=3, random_state=0),
-            {"history_noise_fraction": 1.0},
+            {"history_noise_fraction": 1.0, "average_fraction": 0.0},
         ),
     ],
 )

@@ -52,7 +52,8 @@ def test_layers_are_trained_greedily_on_valid_hidden_probabilities():
         order=2,
         hidden_order=3,
         visible_type="binary",
-        history_noise=0.0,  # the stack's default
+        history_noise=0.0,  # the stack's defaults
+        average_fraction=0.0,
         n_iter=5,
         random_state=top.random_state,
     ).fit(hidden[valid], sequence_ids=ids[valid])
@@ -65,6 +66,7 @@ def test_layers_are_trained_greedily_on_valid_hidden_probabilities():
         order=2,
         hidden_order=3,
         history_noise=0.0,
+        average_fraction=0.0,
         n_iter=5,
         random_state=bottom.random_state,
     ).fit(X, sequence_ids=ids)
