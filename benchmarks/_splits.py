@@ -74,14 +74,11 @@ class Split:
         )
 
 
-# ConditionalRBM's defaults before history_noise_fraction and average_fraction
-# (noise on every channel of the history, the last epoch's parameters kept):
-# the earlier tables' models spell them out.
-EARLIER_DEFAULTS = dict(
-    history_noise=0.8, history_noise_fraction=1.0, average_fraction=0.0
-)
-# The defaults just before average_fraction.
+# ConditionalRBM's defaults just before average_fraction (the last epoch's
+# parameters kept), and those before history_noise_fraction too (noise on
+# every channel of the history): the earlier tables' models spell them out.
 UNAVERAGED = dict(average_fraction=0.0)
+EARLIER_DEFAULTS = dict(UNAVERAGED, history_noise=0.8, history_noise_fraction=1.0)
 
 # What a trained model depends on: the cache key leaves out parameters that
 # only affect inference (and any added later), so changes to inference reuse
