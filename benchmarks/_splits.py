@@ -97,8 +97,9 @@ _LATER_PARAMETERS = {"init": "random", **ConditionalRBM._added_parameters}
 
 # The code a fit runs: a change to any of these (e.g. a new random stream)
 # changes the fitted models, so their text is part of the key too.
-_TRAINING_CODE = [
-    Path(__file__).resolve().parents[1] / "sklearn_crbm" / name
+PACKAGE = Path(__file__).resolve().parents[1] / "sklearn_crbm"
+TRAINING_CODE = [
+    PACKAGE / name
     for name in (
         "_base.py",
         "_crbm.py",
@@ -112,6 +113,26 @@ _TRAINING_CODE = [
 ]
 
 
+# All of the package's code: what a cached fill-in or generation result
+# depends on besides the fit.
+PACKAGE_CODE = sorted(PACKAGE.rglob("*.py"))
+
+
+def hash_code(digest, sources):
+    """``digest`` (a hashlib object) updated with the text of ``sources``."""
+    for source in sources:
+        digest.update(source.read_bytes())
+    return digest
+
+
+def code_digest(sources):
+    """Eight hex digits naming the text of ``sources``.
+
+    Part of a cache key, so that changed code is a new key.
+    """
+    return hash_code(hashlib.sha1(), sources).hexdigest()[:8]
+
+
 def cached_model(cache_dir, model, X, sequence_ids):
     """``(fitted model, training seconds)``, from ``cache_dir`` when it is there."""
     params = {k: getattr(model, k) for k in _TRAINING_PARAMETERS if hasattr(model, k)}
@@ -123,8 +144,7 @@ def cached_model(cache_dir, model, X, sequence_ids):
     digest = hashlib.sha1(repr(sorted(params.items())).encode())
     digest.update(np.ascontiguousarray(X).tobytes())
     digest.update(np.ascontiguousarray(sequence_ids).tobytes())
-    for source in _TRAINING_CODE:
-        digest.update(source.read_bytes())
+    hash_code(digest, TRAINING_CODE)
     path = Path(cache_dir) / f"{type(model).__name__}_{digest.hexdigest()[:20]}.joblib"
     if path.exists():
         return joblib.load(path)

@@ -32,8 +32,10 @@ What ``GridSearchCV(scoring=None)`` does with a ConditionalRBM, measured:
 Every fitted model (pickle), its score and every (configuration, fold)
 result are cached under ``benchmarks/results/model_selection_cache/``, keyed
 on every parameter of the ConditionalRBM and of the CRBMImputer, defaults
-included: a subset (``--sizes 10 50 --orders 1 --folds 0``) can run first
-and the full grid later reuses it, a changed default fits or fills again, and
+included, and on the code they run (a model on the training and scoring
+code, a result on the whole package's): a subset (``--sizes 10 50 --orders
+1 --folds 0``) can run first and the full grid later reuses it, a changed
+default or changed code fits or fills again, and
 ``--paper-fillin`` (the paper's single chain, ``n_particles=1,
 offset_shrinkage=None, observation_gain=1``) fills the same models without refitting them.
 ``model_selection_diagnostics.py`` reads the cached models.  Run from the
@@ -56,6 +58,7 @@ import time
 import numpy as np
 import sklearn
 from _common import DEFAULT_DATA_HOME, RESULTS, print_table, write_json
+from _splits import PACKAGE, PACKAGE_CODE, TRAINING_CODE, code_digest
 from scipy.stats import spearmanr
 from sklearn.frozen import FrozenEstimator
 from sklearn.model_selection import GridSearchCV
@@ -229,11 +232,29 @@ def _digest(estimator, leave_out=()):
     return hashlib.sha1(repr(sorted(params.items())).encode()).hexdigest()[:8]
 
 
+# What a fit and the score cached with it run: changed code is a new key.
+_MODEL_CODE = [*TRAINING_CODE, PACKAGE / "_likelihood.py"]
+
+
 def model_key(n_components, order, fold, args):
     params = model_parameters(n_components, order, args)
     return (
         f"h{n_components}_o{order}_f{fold}_it{args.n_iter}_s{args.seed}"
         f"_hn{params['history_noise']:g}_{_digest(ConditionalRBM(**params))}"
+        f"_c{code_digest(_MODEL_CODE)}"
+    )
+
+
+def fill_key(n_components, order, fold, args):
+    """Cache key of a grid cell's fill-in and generation results.
+
+    Names the model, the imputer's parameters and all of the package's code.
+    """
+    imputer = CRBMImputer(**imputer_parameters(args))
+    digest = _digest(imputer, ("estimator", "random_state", "n_jobs"))
+    return (
+        f"{model_key(n_components, order, fold, args)}_fill{digest}"
+        f"_c{code_digest(PACKAGE_CODE)}"
     )
 
 
@@ -260,10 +281,7 @@ def fitted_model(data, n_components, order, fold, args):
 
 
 def run_one(data, n_components, order, fold, args):
-    imputer = CRBMImputer(**imputer_parameters(args))
-    leave_out = ("estimator", "random_state", "n_jobs")
-    key = f"{model_key(n_components, order, fold, args)}_fill{_digest(imputer, leave_out)}"
-    path = CACHE / f"{key}.json"
+    path = CACHE / f"{fill_key(n_components, order, fold, args)}.json"
     if path.exists() and not args.no_cache:
         return json.loads(path.read_text())
     model, fitted = fitted_model(data, n_components, order, fold, args)

@@ -55,8 +55,8 @@ import numpy as np
 from _common import DEFAULT_DATA_HOME, RESULTS, print_table, write_json
 from model_selection import (
     CACHE,
-    _digest,
     _imputer_for,
+    fill_key,
     fillin,
     fitted_model,
     imputer_parameters,
@@ -70,7 +70,6 @@ import sklearn_crbm._crbm_math as crbm_math
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm._crbm_math import sequence_dynamic_biases
 from sklearn_crbm._likelihood import FrameRBMs, log_partition
-from sklearn_crbm.impute import CRBMImputer
 from sklearn_crbm.model_selection import erasure_mask, make_prediction_scorer
 from sklearn_crbm.utils._sequences import check_sequence_ids
 
@@ -104,9 +103,7 @@ def cached_model(n_components, order, fold, args, seed=None):
 
 def cached_result(n_components, order, fold, args, seed=None):
     """The cached score and fill-in errors of a grid cell (``--paper-fillin`` or not)."""
-    imputer = CRBMImputer(**imputer_parameters(args))
-    digest = _digest(imputer, ("estimator", "random_state", "n_jobs"))
-    key = f"{key_of(n_components, order, fold, args, seed)}_fill{digest}"
+    key = fill_key(n_components, order, fold, _args_for(args, seed))
     return json.loads((CACHE / f"{key}.json").read_text())
 
 
@@ -818,13 +815,9 @@ def training(args):
         X, sequences, frames = _erased_frames(data)
         for order in args.orders:
             for size in args.sizes:
-                fill_digest = _digest(
-                    CRBMImputer(**imputer_parameters(args)),
-                    ("estimator", "random_state", "n_jobs"),
-                )
                 key = (
                     f"{args.variant}_fr{args.fraction:g}_"
-                    f"{model_key(size, order, fold, args)}_fill{fill_digest}"
+                    f"{fill_key(size, order, fold, args)}"
                 )
                 path = cache / f"{key}.json"
                 if path.exists():
