@@ -195,7 +195,7 @@ def main(argv=None):
     for split_name in args.splits:
         split = Split(args.data_home, split_name)
         base = {
-            name: errors(imputer.fit(split.X_train, **_ids(imputer, split)), split)
+            name: errors(fit_baseline(imputer, split.X_train, split.train_ids), split)
             for name, imputer in baselines().items()
         }
         best = {c: min(row[c] for row in base.values()) for c in CELLS}
@@ -229,11 +229,11 @@ def main(argv=None):
     return results
 
 
-def _ids(imputer, split):
-    """AutoregressiveImputer needs the sequences; the others take frames."""
+def fit_baseline(imputer, X, sequence_ids):
+    """``imputer`` fitted on ``X``: AutoregressiveImputer needs the sequences."""
     if isinstance(imputer, AutoregressiveImputer):
-        return {"sequence_ids": split.train_ids}
-    return {}
+        return imputer.fit(X, sequence_ids=sequence_ids)
+    return imputer.fit(X)
 
 
 def report(split_name, trials, base, best, crbm):
