@@ -131,26 +131,28 @@ def crbm_model(name, seed, n_iter, ar_history_noise=None):
 
 
 def fitted_imputer(cache_dir, split, model, seed, n_iter, ar_history_noise=None):
-    """``CRBMImputer(model).fit(X_train)``, with the model's training cached.
+    """``CRBMImputer(model).fit(X_train)`` and the training seconds, cached."""
+    model = crbm_model(model, seed, n_iter, ar_history_noise)
+    X = split.X_train.astype(np.float32)
+    return frozen_imputer(cache_dir, model, X, split.train_ids, seed)
+
+
+def frozen_imputer(cache_dir, model, X, sequence_ids, seed):
+    """``CRBMImputer(model).fit(X)`` and the training seconds, the fit cached.
 
     ``fit`` would train a clone of the model; the cached fitted clone goes in
     through ``FrozenEstimator`` instead (the same imputer, without retraining
     for every run).
     """
-    X = split.X_train.astype(np.float32)
-    fitted, seconds = cached_model(
-        cache_dir,
-        crbm_model(model, seed, n_iter, ar_history_noise),
-        X,
-        split.train_ids,
-    )
+    fitted, seconds = cached_model(cache_dir, model, X, sequence_ids)
     imputer = CRBMImputer(FrozenEstimator(fitted), random_state=seed)
-    return imputer.fit(X, sequence_ids=split.train_ids), seconds
+    return imputer.fit(X, sequence_ids=sequence_ids), seconds
 
 
-def errors(imputer, split):
+def errors(imputer, cases):
+    """The fill-in error of every case (``make_fillin_cases``), by its key."""
     out = {}
-    for cell, case in split.cases.items():
+    for cell, case in cases.items():
         filled = imputer.transform(case.X_missing)
         out[cell] = float(fillin_error(case.X, filled, missing_mask=case.missing_mask))
     return out
@@ -195,7 +197,9 @@ def main(argv=None):
     for split_name in args.splits:
         split = Split(args.data_home, split_name)
         base = {
-            name: errors(fit_baseline(imputer, split.X_train, split.train_ids), split)
+            name: errors(
+                fit_baseline(imputer, split.X_train, split.train_ids), split.cases
+            )
             for name, imputer in baselines().items()
         }
         best = {c: min(row[c] for row in base.values()) for c in CELLS}
@@ -213,7 +217,7 @@ def main(argv=None):
                 for fillin in args.fillins:
                     row = model if fillin == "default" else f"{model}, paper's fill-in"
                     imputer.set_params(**FILLINS[fillin])
-                    crbm.setdefault(row, {})[seed] = errors(imputer, split)
+                    crbm.setdefault(row, {})[seed] = errors(imputer, split.cases)
                 print(
                     f"  {split_name} {model} seed {seed}: trained in {seconds:.0f} s",
                     flush=True,

@@ -43,14 +43,16 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 from _common import DEFAULT_DATA_HOME, print_table, write_json  # noqa: E402
-from _splits import Split, cached_model  # noqa: E402
-from fillin_baselines import baselines, fit_baseline  # noqa: E402
-from sklearn.frozen import FrozenEstimator  # noqa: E402
+from _splits import Split  # noqa: E402
+from fillin_baselines import (  # noqa: E402
+    baselines,
+    crbm_model,
+    errors,
+    fit_baseline,
+    frozen_imputer,
+)
 
-from sklearn_crbm import ConditionalRBM  # noqa: E402
 from sklearn_crbm.datasets import load_cmu35  # noqa: E402
-from sklearn_crbm.impute import CRBMImputer  # noqa: E402
-from sklearn_crbm.metrics import fillin_error  # noqa: E402
 from sklearn_crbm.model_selection import make_fillin_cases  # noqa: E402
 
 N_FOLDS = 3
@@ -63,28 +65,6 @@ def style_folds(cmu, trials):
         for k, trial in enumerate(t for t in trials if cmu.motion[t] == style):
             folds[k % N_FOLDS].append(int(trial))
     return folds
-
-
-def case_errors(imputer, cases):
-    return {
-        key: float(
-            fillin_error(
-                case.X,
-                imputer.transform(case.X_missing),
-                missing_mask=case.missing_mask,
-            )
-        )
-        for key, case in cases.items()
-    }
-
-
-def crbm_imputer(cache_dir, model_params, imputer_params, seed, X, sequence_ids):
-    model = ConditionalRBM(200, order=3, n_iter=1000, random_state=seed)
-    fitted, _ = cached_model(
-        cache_dir, model.set_params(**model_params), X, sequence_ids
-    )
-    imputer = CRBMImputer(FrozenEstimator(fitted), random_state=seed)
-    return imputer.set_params(**imputer_params).fit(X, sequence_ids=sequence_ids)
 
 
 def by_cell_type(scores):
@@ -147,17 +127,22 @@ def main(argv=None):
         train = ~np.isin(split.train_ids, fold)
         X_fit, ids_fit = X[train], split.train_ids[train]
         base = [
-            case_errors(fit_baseline(b, X_fit, ids_fit), cases)
-            for b in baselines().values()
+            errors(fit_baseline(b, X_fit, ids_fit), cases) for b in baselines().values()
         ]
-        best = {key: min(errors[key] for errors in base) for key in cases}
+        best = {key: min(row[key] for row in base) for key in cases}
         for model_params, imputer_params in variants:
             name = variant_name(model_params, imputer_params)
             for seed in args.seeds:
-                imputer = crbm_imputer(
-                    args.cache_dir, model_params, imputer_params, seed, X_fit, ids_fit
+                model = crbm_model("default", seed, n_iter=1000)
+                imputer, _ = frozen_imputer(
+                    args.cache_dir,
+                    model.set_params(**model_params),
+                    X_fit,
+                    ids_fit,
+                    seed,
                 )
-                for key, error in case_errors(imputer, cases).items():
+                imputer.set_params(**imputer_params)
+                for key, error in errors(imputer, cases).items():
                     scores.setdefault((name, seed), []).append(
                         dict(
                             fold=k,
@@ -172,15 +157,15 @@ def main(argv=None):
 
     rows = []
     for (name, seed), cells in scores.items():
-        errors = np.array([c["error"] for c in cells])
+        crbm = np.array([c["error"] for c in cells])
         best = np.array([c["best_baseline"] for c in cells])
         rows.append(
             dict(
                 variant=name,
                 seed=seed,
-                total=float(errors.sum()),
-                log_ratio=float(np.mean(np.log(errors / best))),
-                won=int(np.sum(errors < best)),
+                total=float(crbm.sum()),
+                log_ratio=float(np.mean(np.log(crbm / best))),
+                won=int(np.sum(crbm < best)),
                 n_cells=len(cells),
             )
         )

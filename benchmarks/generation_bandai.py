@@ -53,6 +53,7 @@ import sklearn  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import DEFAULT_DATA_HOME, print_table, write_json  # noqa: E402
+from _splits import EARLIER_DEFAULTS  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
 from sklearn_crbm.datasets import read_bvh_folder  # noqa: E402
@@ -104,13 +105,7 @@ def run(walks, *, n_iter, seed, n_sequences, n_frames, encoding):
         pre = make_motion_preprocessor(skeleton, **ENCODINGS[encoding])
         Z = pre.fit_transform(walks.data, sequence_ids=ids)
     model = ConditionalRBM(
-        200,
-        order=3,
-        n_iter=n_iter,
-        history_noise=0.8,
-        history_noise_fraction=1.0,
-        average_fraction=0.0,
-        random_state=seed,
+        200, order=3, n_iter=n_iter, random_state=seed, **EARLIER_DEFAULTS
     )
     start = time.perf_counter()
     model.fit(Z.astype(np.float32), sequence_ids=ids)

@@ -68,6 +68,7 @@ from pathlib import Path  # noqa: E402
 import joblib  # noqa: E402
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
+from _splits import EARLIER_DEFAULTS  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
 from sklearn_crbm.datasets import bone_columns, load_cmu35  # noqa: E402
@@ -319,8 +320,8 @@ def train_crbm(cache_dir, Z, ids, seed, n_iter, params):
 
 
 def variant_params(name, history_noise):
-    # on every channel and unaveraged, as when these were measured
-    params = dict(VARIANTS[name], history_noise_fraction=1.0, average_fraction=0.0)
+    # the defaults of when these were measured, with the variant's noise
+    params = {**EARLIER_DEFAULTS, **VARIANTS[name]}
     if params["history_noise"] is None:
         params["history_noise"] = history_noise
     return params

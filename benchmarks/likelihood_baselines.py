@@ -65,9 +65,10 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 from _splits import (  # noqa: E402
+    EARLIER_DEFAULTS,
     SPLITS,
     Split,
-    cached_model,  # noqa: E402
+    cached_model,
 )
 from scipy.stats import multivariate_normal, norm  # noqa: E402
 
@@ -148,15 +149,9 @@ ROW_PARAMETERS = {
 
 
 def row_model(row, seed, init="random", history_noise=0.8):
-    model = ConditionalRBM(
-        200,
-        order=ORDER,
-        init=init,
-        history_noise=history_noise,
-        history_noise_fraction=1.0,
-        average_fraction=0.0,
-        random_state=seed,
-    )
+    # the earlier defaults' training, with the row's noise level
+    earlier = dict(EARLIER_DEFAULTS, history_noise=history_noise)
+    model = ConditionalRBM(200, order=ORDER, init=init, random_state=seed, **earlier)
     return model.set_params(**ROW_PARAMETERS[row])
 
 

@@ -62,6 +62,7 @@ from model_selection import (
     imputer_parameters,
     load_fold,
     model_key,
+    model_parameters,
     run_one,
 )
 from scipy.stats import spearmanr
@@ -455,13 +456,7 @@ def epochs(args):
         for order in args.orders:
             for size in args.sizes:
                 model = ConditionalRBM(
-                    size,
-                    order=order,
-                    n_iter=checkpoints[0],
-                    history_noise=args.history_noise,
-                    history_noise_fraction=args.history_noise_fraction,
-                    average_fraction=args.average_fraction,
-                    random_state=args.seed,
+                    **dict(model_parameters(size, order, args), n_iter=checkpoints[0])
                 )
                 model.fit(data["Z_train"], sequence_ids=data["train_ids"])
                 for epoch in checkpoints:
@@ -779,13 +774,7 @@ def _train_variant(data, size, order, fold, args):
         args.n_iter if args.variant == "sampled" else round(args.fraction * args.n_iter)
     )
     model = ConditionalRBM(
-        size,
-        order=order,
-        n_iter=args.n_iter - n_last,
-        history_noise=args.history_noise,
-        history_noise_fraction=args.history_noise_fraction,
-        average_fraction=args.average_fraction,
-        random_state=args.seed,
+        **dict(model_parameters(size, order, args), n_iter=args.n_iter - n_last)
     )
     X, ids = data["Z_train"], data["train_ids"]
     changed = (
