@@ -14,8 +14,9 @@ Protocol:
   averaged; ``centred``: that with ``centering=True``),
   cached with the other generation benchmarks;
 - per training seed, 6 walk-seeded and 6 jog-seeded sequences of 1000
-  frames (seeds of ``order`` real frames drawn as in
-  ``generation_styles.py``; ``sample`` with its defaults);
+  frames (seeds of the model's ``history_length`` real frames, ``order``
+  unless ``hidden_order`` is larger, drawn as in ``generation_styles.py``;
+  ``sample`` with its defaults);
 - judged over frames 200-299 (the last 100 of the first 300) and over
   frames 900-999 (the last 100 of 1000); a sequence *passes* a window when
   it keeps its seed's style (nearest style on forward speed and step
@@ -184,7 +185,7 @@ def main(argv=None):
                 motion.ids,
             )
             seeds, seed_styles = draw_seeds(
-                motion, args.n_per_style, crbm.order, np.random.default_rng(seed)
+                motion, args.n_per_style, crbm.history_length, np.random.default_rng(seed)
             )
             generated = crbm.sample(n_frames, history=seeds, random_state=seed)
             row = dict(model=name, seed=seed, train_seconds=seconds)
