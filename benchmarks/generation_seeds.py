@@ -185,7 +185,10 @@ def main(argv=None):
                 motion.ids,
             )
             seeds, seed_styles = draw_seeds(
-                motion, args.n_per_style, crbm.history_length, np.random.default_rng(seed)
+                motion,
+                args.n_per_style,
+                crbm.history_length,
+                np.random.default_rng(seed),
             )
             generated = crbm.sample(n_frames, history=seeds, random_state=seed)
             row = dict(model=name, seed=seed, train_seconds=seconds)
