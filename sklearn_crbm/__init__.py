@@ -8,8 +8,9 @@ preprocessing, on-line filling in of missing channels, and generation.
 
 from . import datasets, metrics, model_selection, plotting, preprocessing
 from ._config import config_context, get_config, set_config
-from ._crbm import ConditionalRBM, TrainingDivergedError
+from ._crbm import ConditionalRBM
 from ._stacked import StackedCRBM
+from ._training import TrainingDivergedError
 from .impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from .preprocessing import (
     ExpMapEncoder,

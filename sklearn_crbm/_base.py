@@ -17,17 +17,14 @@ from sklearn.utils.validation import (
     validate_data,
 )
 
-from ._crbm_math import (
-    sequence_dynamic_biases,
-    sequence_hidden_probabilities,
-    stacked_prediction,
-)
+from ._gibbs import stacked_prediction
+from ._layer import sequence_frame_rbms, sequence_hidden_probabilities
 from ._likelihood import (
     LogLikelihood,
     frame_log_likelihood,
     stack_log_likelihood_bound,
 )
-from ._online import History, run_online
+from ._online import TOP_LAYER, History, run_online
 from .utils._array_api import array_ops, array_random, is_numpy
 from .utils._parallel import SAMPLE_BLOCK, map_sequence_blocks
 from .utils._persistence import VersionedPickleMixin
@@ -46,7 +43,7 @@ AIS_STEPS, AIS_CHAINS = 50, 2
 # Draws of the lower layers' hidden units per frame in a stack's bound.
 BOUND_SAMPLES = 10
 # Standard deviation of the jitter added to the previous frame to start the
-# Gibbs chain of a new frame (REFERENCE.md, gen.m).
+# Gibbs chain of a new frame, as in the original code's generation.
 START_JITTER = 0.01
 
 
@@ -59,15 +56,16 @@ class BaseCRBM(
 ):
     """Base class of the conditional RBMs: one layer or a stack of them.
 
-    A fitted model is a stack of CRBM layers, bottom first (one for
+    A fitted model is a stack of conditional layers
+    (:mod:`sklearn_crbm._layer`), bottom first (one for
     :class:`ConditionalRBM`); the visible units of layer ``k + 1`` are the
     hidden units of layer ``k``.  This class holds everything that is the
     same for any such stack: input checks, :meth:`transform`,
     :meth:`predict_next`, :meth:`score` and :meth:`score_samples`,
     :meth:`sample` with its seed windows, and the constants.  Subclasses
-    fit, and provide the hooks :attr:`history_length`, ``_layer_parameters``
-    (the packed parameters of every layer) and, for generation,
-    ``_generation_scheme`` and ``_chain_rng``.
+    fit, and provide the hooks :attr:`history_length`, ``_layers`` (every
+    fitted layer) and, where they differ from the defaults,
+    ``_ais_settings`` and ``_chain_rng``.
     """
 
     _parameter_constraints: dict = {
@@ -86,6 +84,9 @@ class BaseCRBM(
         "verbose": ["verbose"],
     }
 
+    # Noise on the previous frame where a new frame's Gibbs chain starts.
+    _start_jitter = START_JITTER
+
     # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
     # search passes ``sequence_ids`` to these methods without being asked.
     __metadata_request__fit = {"sequence_ids": True}
@@ -101,11 +102,25 @@ class BaseCRBM(
         """Past frames a frame's top-layer representation depends on."""
 
     @abstractmethod
-    def _layer_parameters(self):
-        """The fitted :class:`~sklearn_crbm._crbm_math.CRBMParameters`, bottom first."""
+    def _layers(self):
+        """The fitted :class:`~sklearn_crbm._layer.ConditionalLayer` s, bottom first."""
 
-    # How a stack draws a new frame in ``sample`` (see sklearn_crbm._online).
-    _generation_scheme = "top_layer"
+    def _ais_settings(self):
+        """Intermediate distributions and chains per frame of the annealing."""
+        return AIS_STEPS, AIS_CHAINS
+
+    def _online_context(self, X, style):
+        """What on-line fill-in conditions on: ``(frame_context, hypotheses)``.
+
+        None and None for a model without context; a style model gives the
+        style of every frame of ``X``, or hypotheses for particles to weigh.
+        """
+        if style is not None:
+            raise ValueError(
+                f"{type(self).__name__} has no styles: fill in without style=, or "
+                "with a style model such as FactoredCRBM."
+            )
+        return None, None
 
     def _chain_rng(self, rng):
         """The generator of ``sample``'s chains, given the one that picked seeds."""
@@ -155,7 +170,7 @@ class BaseCRBM(
         ops = array_ops(X)
         windows = ops.take(X, rows.ravel(), axis=0)
         windows = ops.reshape(windows, (*rows.shape, X.shape[1]))
-        return ops.astype(windows, self._layer_parameters()[0].dtype, copy=True)
+        return ops.astype(windows, self._layers()[0].dtype, copy=True)
 
     def _merge_seed_windows(self, new):
         """Seed windows of a ``partial_fit`` call joined to the earlier ones."""
@@ -171,7 +186,7 @@ class BaseCRBM(
     @property
     def _packed_parameters(self):
         """The bottom layer's parameter buffer: the fitted namespace and device."""
-        return self._layer_parameters()[0].flat
+        return self._layers()[0].flat
 
     def _check_namespace(self, X, method):
         """A clear error unless ``X`` can meet the fitted parameters."""
@@ -192,17 +207,33 @@ class BaseCRBM(
         xp = get_namespace(X)[0]
         X = validate_data(self, X, dtype=[xp.float64, xp.float32], reset=False)
         ops = array_ops(X)
-        X = ops.astype(X, self._layer_parameters()[0].dtype, copy=False)
+        X = ops.astype(X, self._layers()[0].dtype, copy=False)
         return X, check_sequence_ids(sequence_ids, X.shape[0])
 
-    def _representations(self, X, sequences, layers):
+    def _representations(self, X, sequences, layers, context=None):
         """The data, then ``layers``' hidden probabilities of it, bottom first."""
         representations = [X]
-        for params in layers:
+        for layer in layers:
             representations.append(
-                sequence_hidden_probabilities(params, representations[-1], sequences)
+                sequence_hidden_probabilities(
+                    layer, representations[-1], sequences, context
+                )
             )
         return representations
+
+    def _stack_chunks(self, X, sequences, frames=None, context=None):
+        """Yield ``(rows, stack)``: every layer's frame RBMs of chunks of frames."""
+        layers = self._layers()
+        representations = self._representations(X, sequences, layers[:-1], context)
+        chunks = zip(
+            *(
+                sequence_frame_rbms(layer, values, sequences, frames, context)
+                for layer, values in zip(layers, representations, strict=True)
+            ),
+            strict=True,
+        )
+        for per_layer in chunks:
+            yield per_layer[0][0], [rbms for _, rbms in per_layer]
 
     @limit_blas_threads(frame_rows)
     def transform(self, X, *, sequence_ids=None):
@@ -229,7 +260,7 @@ class BaseCRBM(
             Hidden probabilities of the top layer, in the dtype of the model.
         """
         X, sequences = self._check_inference_input(X, sequence_ids)
-        return self._representations(X, sequences, self._layer_parameters())[-1]
+        return self._representations(X, sequences, self._layers())[-1]
 
     @limit_blas_threads(frame_rows)
     def predict_next(self, X, *, sequence_ids=None):
@@ -260,26 +291,13 @@ class BaseCRBM(
         X, sequences = self._check_inference_input(X, sequence_ids, "predict_next")
         return self._predict_frames(X, sequences)
 
-    def _predict_frames(self, X, sequences, frames=None):
-        layers = self._layer_parameters()
-        representations = self._representations(X, sequences, layers[:-1])
+    def _predict_frames(self, X, sequences, frames=None, context=None):
         frames = np.arange(X.shape[0]) if frames is None else frames
         predicted = array_ops(X).empty((len(frames), X.shape[1]), dtype=X.dtype)
-        chunks = zip(
-            *(
-                sequence_dynamic_biases(params, values, sequences, frames)
-                for params, values in zip(layers, representations, strict=True)
-            ),
-            strict=True,
-        )
         position = 0
-        for per_layer in chunks:
-            rows = per_layer[0][0]
+        for rows, stack in self._stack_chunks(X, sequences, frames, context):
             predicted[position : position + len(rows), ...] = stacked_prediction(
-                layers,
-                [visible_bias for _, visible_bias, _ in per_layer],
-                [hidden_bias for _, _, hidden_bias in per_layer],
-                SCORE_MEAN_FIELD_STEPS,
+                stack, SCORE_MEAN_FIELD_STEPS
             )
             position += len(rows)
         return predicted
@@ -322,66 +340,46 @@ class BaseCRBM(
             each frame given its history, in the dtype of the model.
         """
         X, sequences = self._check_inference_input(X, sequence_ids, "score_samples")
-        log_likelihood = self._log_likelihood(X, sequences).log_likelihood
+        log_likelihood = self._frame_log_likelihoods(X, sequences)
         return array_ops(X).astype(log_likelihood, X.dtype)
 
-    def _ais_settings(self):
-        """Intermediate distributions and chains per frame of the annealing."""
-        return getattr(self, "ais_steps", AIS_STEPS), getattr(
-            self, "ais_chains", AIS_CHAINS
-        )
+    def _frame_log_likelihoods(self, X, sequences, y=None):
+        """Every frame's log-likelihood, given ``y`` (ignored by a model without
+        context: it is what a search passes to ``score``)."""
+        return self._log_likelihood(X, sequences).log_likelihood
 
-    def _visible_scale(self):
-        """Standard deviation of the bottom layer's Gaussian visibles (or None)."""
-        bottom = getattr(self, "layers_", [self])[0]
-        variance = getattr(bottom, "visible_variance_", None)
-        return None if variance is None else array_ops(variance).sqrt(variance)
-
-    def _log_likelihood(self, X, sequences, method="auto", reverse=False, rng=None):
+    def _log_likelihood(
+        self, X, sequences, method="auto", reverse=False, rng=None, context=None
+    ):
         """:class:`~sklearn_crbm._likelihood.LogLikelihood` of every frame."""
-        layers = self._layer_parameters()
+        layers = self._layers()
         n_steps, n_chains = self._ais_settings()
         rng = rng_from(self.random_state) if rng is None else rng
         rng = array_random(rng, X)  # numpy's own stream for numpy input
         if len(layers) == 1:
             return frame_log_likelihood(
-                layers[0],
-                self._visible_scale(),
                 X,
-                sequence_dynamic_biases(layers[0], X, sequences),
+                sequence_frame_rbms(layers[0], X, sequences, context=context),
+                shared=layers[0].n_lags == 0 and context is None,
                 method=method,
                 n_steps=n_steps,
                 n_chains=n_chains,
                 reverse=reverse,
                 rng=rng,
             )
-        representations = self._representations(X, sequences, layers[:-1])
-        scales = [self._visible_scale()] + [None] * (len(layers) - 1)
-        bounds = []
-        chunks = zip(
-            *(
-                sequence_dynamic_biases(params, values, sequences)
-                for params, values in zip(layers, representations, strict=True)
-            ),
-            strict=True,
-        )
-        for per_layer in chunks:
-            bounds.append(
-                stack_log_likelihood_bound(
-                    list(zip(layers, scales, strict=True)),
-                    array_ops(X).take(X, per_layer[0][0], axis=0),
-                    [
-                        (visible_bias, hidden_bias)
-                        for _, visible_bias, hidden_bias in per_layer
-                    ],
-                    n_samples=BOUND_SAMPLES,
-                    rng=rng,
-                    method=method,
-                    n_steps=n_steps,
-                    n_chains=n_chains,
-                )
-            )
         ops = array_ops(X)
+        bounds = [
+            stack_log_likelihood_bound(
+                stack,
+                ops.take(X, rows, axis=0),
+                n_samples=BOUND_SAMPLES,
+                rng=rng,
+                method=method,
+                n_steps=n_steps,
+                n_chains=n_chains,
+            )
+            for rows, stack in self._stack_chunks(X, sequences, context=context)
+        ]
         bound = ops.concatenate(bounds)
         return LogLikelihood(bound, None, ops.zeros_like(bound), "bound")
 
@@ -427,7 +425,7 @@ class BaseCRBM(
             )
         ops = array_ops(X)
         # every frame, as score_samples draws them: the same random numbers
-        log_likelihood = self._log_likelihood(X, sequences).log_likelihood
+        log_likelihood = self._frame_log_likelihoods(X, sequences, y)
         log_likelihood = ops.take(log_likelihood, frames, axis=0)
         if sample_weight is None:
             return float(ops.mean(log_likelihood))
@@ -515,19 +513,38 @@ class BaseCRBM(
             raise ValueError(
                 f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
             )
-        layers = self._layer_parameters()
         rng = rng_from(self.random_state if random_state is None else random_state)
         seed = seed_frames(
             history,
             n_sequences,
             width=max(self.history_length, 1),
             n_features=self.n_features_in_,
-            dtype=layers[0].dtype,
+            dtype=self._layers()[0].dtype,
             seed_windows=self.seed_windows_,
             rng=rng,
         )
-        past = History.from_frames(layers, seed[None, ...])
+        return self._generate(
+            seed,
+            n_samples,
+            rng,
+            n_gibbs=n_gibbs,
+            hidden_noise=hidden_noise,
+            sample_visibles=sample_visibles,
+            n_jobs=n_jobs,
+        )
+
+    def _generate(self, seed, n_samples, rng, *, context=None, n_jobs=None, **gibbs):
+        """``n_samples`` frames after each seed, in long format (see :meth:`sample`).
+
+        ``seed`` has shape ``(n_sequences, width, n_features)``; ``context``
+        (shape ``(n_sequences, n_samples, n_context)``) gives each new frame's
+        context to a layer that takes one.  ``gibbs`` holds ``n_gibbs``,
+        ``hidden_noise`` and ``sample_visibles``.
+        """
+        layers = self._layers()
         ops = layers[0].ops
+        seed_context = None if context is None else context[None, :, 0, ...]
+        past = History.from_frames(layers, seed[None, ...], seed_context)
 
         def generate_block(block, block_rng):
             shape = (len(block), n_samples, seed.shape[2])
@@ -537,13 +554,12 @@ class BaseCRBM(
                 array_random(block_rng, seed),
                 history=past.select(block),
                 n_steps=n_samples,
-                n_gibbs=n_gibbs,
-                scheme=self._generation_scheme,
-                start_jitter=START_JITTER,
-                hidden_noise=hidden_noise,
-                sample_visibles=sample_visibles,
+                context=None if context is None else ops.take(context, block, axis=0),
+                scheme=TOP_LAYER,
+                start_jitter=self._start_jitter,
+                **gibbs,
             )
-            for step, _, _, new in run:
+            for step, new in run:
                 frames[:, step, ...] = new[0, ...]
             return frames
 
@@ -561,7 +577,7 @@ class BaseCRBM(
 
     @property
     def _n_features_out(self):
-        return self._layer_parameters()[-1].n_components
+        return self._layers()[-1].n_components
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
@@ -573,8 +589,8 @@ class FittedParameter:
     """A fitted attribute that views a group of the packed parameters.
 
     ``components_ = FittedParameter("weights")`` on the class makes
-    ``model.components_`` the ``weights`` view of ``model._parameters``
-    (:class:`~sklearn_crbm._crbm_math.CRBMParameters`); an unfitted model
+    ``model.components_`` the ``weights`` view of ``model._layer`` (a
+    :class:`~sklearn_crbm._layer.ConditionalLayer`); an unfitted model
     has no such attribute.  Assigning to it writes into the view (same
     shape only), so the model computes with what was assigned.  A group that
     the parameters compute (``visible_variance``, from
@@ -592,7 +608,7 @@ class FittedParameter:
         if instance is None:
             return self
         try:
-            params = vars(instance)["_parameters"]
+            params = vars(instance)["_layer"]
         except KeyError:
             raise AttributeError(
                 f"{type(instance).__name__!r} object has no attribute {self.name!r}"
@@ -607,7 +623,7 @@ class FittedParameter:
                 f"{self.name} has shape {view.shape}; got an array of shape "
                 f"{value.shape}. Set the size parameters and refit to change it."
             )
-        params = vars(instance)["_parameters"]
+        params = vars(instance)["_layer"]
         computed = getattr(type(params), self.group, None)
         if isinstance(computed, property) and computed.fset is not None:
             setattr(params, self.group, value)  # visible_variance, not a view

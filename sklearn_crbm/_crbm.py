@@ -1,56 +1,29 @@
 """Conditional Restricted Boltzmann Machine (Taylor, Hinton & Roweis, 2006)."""
 
-import math
-import time
-from functools import partial
-from numbers import Integral, Real
+from numbers import Integral
 
 import numpy as np
-from sklearn.base import _fit_context
 from sklearn.externals import array_api_compat
-from sklearn.utils import Bunch, check_random_state
+from sklearn.utils import Bunch
 from sklearn.utils._array_api import (
     _convert_to_numpy,
-    get_namespace_and_device,
-    move_to,
 )
 from sklearn.utils._param_validation import Interval, StrOptions
-from sklearn.utils.validation import validate_data
 
-from ._base import BaseCRBM, FittedParameter
-from ._crbm_math import (
-    BINARY,
-    MIN_LOG_VARIANCE,
-    CDWorkspace,
-    CRBMParameters,
-    MomentumUpdate,
-    ParameterAverage,
-    add_history_noise,
-    cd_gradients,
-    shift_centred,
-)
-from .utils._array_api import array_ops, array_random, to_device_batches
+from ._base import FittedParameter
+from ._base_layer import BaseLayerModel
+from ._crbm_layer import MIN_LOG_VARIANCE, CRBMLayer
+from ._layer import BINARY
+from .utils._array_api import array_ops
 from .utils._autoregression import ridge_autoregression
-from .utils._fitting import unfitted_on_error
 from .utils._random import rng_from
-from .utils._sequences import (
-    balanced_batches,
-    check_sequence_ids,
-    frame_history,
-    shuffled_batches,
-    validation_split,
-)
-from .utils._threads import batch_rows, frame_rows, limit_blas_threads
+from .utils._threads import frame_rows, limit_blas_threads
 
 # Ridge penalty of init="autoregressive": AutoregressiveImputer's default.
 _AUTOREGRESSIVE_ALPHA = 1.0
 
 
-class TrainingDivergedError(FloatingPointError):
-    """Training produced non-finite weights (the learning rate is too large)."""
-
-
-class ConditionalRBM(BaseCRBM):
+class ConditionalRBM(BaseLayerModel):
     """Conditional Restricted Boltzmann Machine for sequences of frames.
 
     Models each frame ``v_t`` with visible units (Gaussian with unit variance
@@ -341,21 +314,12 @@ class ConditionalRBM(BaseCRBM):
     """
 
     _parameter_constraints: dict = {
-        **BaseCRBM._parameter_constraints,
+        **BaseLayerModel._parameter_constraints,
         "n_components": [Interval(Integral, 1, None, closed="left")],
         "visible_type": [StrOptions({"gaussian", "binary"})],
-        "ais_steps": [Interval(Integral, 1, None, closed="left")],
-        "ais_chains": [Interval(Integral, 1, None, closed="left")],
-        "early_stopping": ["boolean"],
-        "validation_fraction": [Interval(Real, 0, 1, closed="neither")],
-        "n_iter_no_change": [Interval(Integral, 1, None, closed="left")],
-        "validation_interval": [Interval(Integral, 1, None, closed="left")],
-        "tol": [Interval(Real, 0, None, closed="left")],
         "visible_variance": [StrOptions({"unit", "learned", "residual"})],
         "init": [StrOptions({"random", "autoregressive"})],
         "centering": ["boolean"],
-        "history_noise_fraction": [Interval(Real, 0, 1, closed="right")],
-        "average_fraction": [Interval(Real, 0, 1, closed="left")],
     }
 
     _added_parameters = {
@@ -363,10 +327,6 @@ class ConditionalRBM(BaseCRBM):
         "history_noise_fraction": 1.0,
         "average_fraction": 0.0,
     }
-
-    # Private state that a failed fit must forget with the fitted attributes:
-    # the packed parameters (which the public ones view) and the velocities.
-    _training_state = ("_parameters", "_velocity")
 
     components_ = FittedParameter("weights")
     intercept_hidden_ = FittedParameter("hidden_bias")
@@ -434,7 +394,7 @@ class ConditionalRBM(BaseCRBM):
         self.random_state = random_state
         self.verbose = verbose
 
-    # The training of the paper and its released code (REFERENCE.md).
+    # The training of the paper and its released code.
     _PAPER_SCHEDULE = dict(
         n_components=200,
         order=3,
@@ -486,106 +446,22 @@ class ConditionalRBM(BaseCRBM):
         """
         return cls(**{**cls._PAPER_SCHEDULE, **params})
 
-    # ------------------------------------------------------------------ fit
+    # ------------------------------------------------------------ hooks
 
-    @limit_blas_threads(batch_rows)
-    @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y=None, *, sequence_ids=None):
-        """Train the model on sequences of frames.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-
-        Returns
-        -------
-        self : ConditionalRBM
-            The fitted model.
-        """
-        with unfitted_on_error(self):
-            xp, _ = get_namespace_and_device(X)[:2]
-            X = validate_data(self, X, dtype=[xp.float64, xp.float32], reset=True)
-            sequences, frames = self._check_sequences(X, sequence_ids)
-            self.random_state_ = check_random_state(self.random_state)
-            self._initialize(X)
-            if self.early_stopping:
-                self._train_with_early_stopping(X, sequences)
-            else:
-                self._start_autoregressive(X, frames)
-                n_averaged = math.ceil(self.average_fraction * self.n_iter)
-                self._train(X, frames, self.n_iter, n_averaged)
-            self.seed_windows_ = self._pick_seed_windows(X, sequences)
-        return self
-
-    @limit_blas_threads(batch_rows)
-    @_fit_context(prefer_skip_nested_validation=True)
-    def partial_fit(self, X, y=None, *, sequence_ids=None):
-        """Train for one epoch on the given sequences, keeping the current state.
-
-        The first call initialises the model; later calls continue from the
-        current parameters, momentum and epoch count.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-
-        Returns
-        -------
-        self : ConditionalRBM
-            The updated model.
-        """
-        first_call = not hasattr(self, "components_")
-        # bad input leaves a fitted model as it was; divergence unfits it
-        with unfitted_on_error(self, Exception if first_call else ()):
-            xp = get_namespace_and_device(X)[0]
-            if not first_call:
-                self._check_namespace(X, "partial_fit")
-            X = validate_data(
-                self,
-                X,
-                dtype=[xp.float64, xp.float32]
-                if first_call
-                else self._parameters.dtype,
-                reset=first_call,
-            )
-            sequences, frames = self._check_sequences(X, sequence_ids)
-        with unfitted_on_error(self):
-            if first_call:
-                self.random_state_ = check_random_state(self.random_state)
-                self._initialize(X)
-                self._start_autoregressive(X, frames)
-            self._train(X, frames, 1)
-        self.seed_windows_ = self._merge_seed_windows(
-            self._pick_seed_windows(X, sequences)
+    def _new_layer(self, n_features, dtype):
+        return CRBMLayer(
+            n_features,
+            self.n_components,
+            self.order,
+            self._hidden_order,
+            self.visible_type,
+            dtype,
+            learned_variance=self.visible_variance == "learned",
+            fixed_variance=self.visible_variance == "residual",
+            centered=self.centering,
         )
-        return self
 
-    @property
-    def history_length(self):
-        """Past frames a frame depends on: ``max(order, hidden_order)``.
-
-        :meth:`sample` needs this many seed frames (at least one), and
-        :meth:`score` judges frames with this many past frames in their
-        sequence.
-        """
-        return self._n_lags
-
-    def _layer_parameters(self):
-        return [self._parameters]
-
-    def _check_sequences(self, X, sequence_ids):
-        """Validate ids and visible type; return the sequences and trainable frames."""
-        sequences = check_sequence_ids(sequence_ids, X.shape[0])
+    def _check_training_data(self, X):
         if self.visible_type == BINARY and self.visible_variance != "unit":
             raise ValueError(
                 f"visible_variance={self.visible_variance!r} needs Gaussian "
@@ -618,46 +494,8 @@ class ConditionalRBM(BaseCRBM):
                 f"probabilities); got values in [{low:g}, {high:g}]. Use "
                 "visible_type='gaussian' for standardised real-valued data."
             )
-        frames = sequences.valid_frames(self._n_lags)
-        if len(frames) == 0:
-            longest = int(sequences.lengths.max()) if len(sequences.lengths) else 0
-            noun = "sample" if longest == 1 else "samples"
-            raise ValueError(
-                f"No frame has {self._n_lags} past frames in its own sequence: the "
-                f"longest sequence has {longest} {noun}, but a model of order "
-                f"{self._n_lags} needs sequences of at least {self._n_lags + 1} "
-                "frames. Pass longer sequences (check sequence_ids) or lower order."
-            )
-        return sequences, frames
 
-    def _initialize(self, X):
-        """Draw the start parameters, in the namespace and on the device of ``X``.
-
-        They are drawn with numpy (the same numbers for every namespace) and
-        moved to ``X``'s namespace and device.
-        """
-        ops = array_ops(X)
-        params = CRBMParameters.initialize(
-            X.shape[1],
-            self.n_components,
-            self.order,
-            self._hidden_order,
-            self.visible_type,
-            np.float32 if X.dtype == ops.float32 else np.float64,
-            rng_from(self.random_state_),
-            learned_variance=self.visible_variance == "learned",
-            fixed_variance=self.visible_variance == "residual",
-        )
-        if ops is not np:
-            xp, _, device = get_namespace_and_device(X)
-            params = params.__sklearn_array_api_convert__(
-                partial(move_to, xp=xp, device=device)
-            )
-        self.n_iter_ = 0
-        self._parameters = params
-        self._velocity = params.zeros_like(layout="F")
-
-    def _start_autoregressive(self, X, frames):
+    def _start_parameters(self, X, frames, context=None):
         """Start from the ridge AR of ``frames`` where the parameters ask for it.
 
         ``init="autoregressive"`` sets the autoregressive weights, the
@@ -676,155 +514,12 @@ class ConditionalRBM(BaseCRBM):
         if self.init == "autoregressive":
             self.autoregressive_ = fit.coef.astype(X.dtype)
             self.intercept_visible_ = fit.intercept.astype(X.dtype)
-        learned = self._parameters.learned_variance
+        learned = self._layer.learned_variance
         if residual or (learned and self.init == "autoregressive"):
             variance = np.mean(np.square(fit.residual), axis=0)
             self.visible_variance_ = np.maximum(
                 variance, np.exp(MIN_LOG_VARIANCE)
             ).astype(X.dtype)
-
-    # Diverging weights overflow in the products before the epoch's check
-    # raises TrainingDivergedError, which says what to do.
-    @np.errstate(over="ignore", invalid="ignore")
-    def _train(self, X, frames, n_epochs, n_averaged=0):
-        """``n_epochs`` epochs of CD; the parameters kept are the mean of those
-        at the ends of the last ``n_averaged`` epochs (0: the last epoch's)."""
-        # trained in the layout BLAS runs fastest, kept in C order when fitted
-        params = self._parameters.copy(layout="F")
-        if self.centering:  # trained in centred coordinates, kept in the standard form
-            shift_centred(params, 1)
-        update = MomentumUpdate(params, self._velocity)
-        self._velocity = update.velocity
-        # Minibatches gather rows: from a Fortran-ordered X (what many
-        # transformers return) every row would be a strided read.
-        ops = array_ops(X)
-        X = ops.ascontiguousarray(X)
-        plan_batches = (
-            balanced_batches if self.batching == "balanced" else shuffled_batches
-        )
-        n_lags = params.n_lags
-        # Buffers reused by every minibatch
-        workspace = CDWorkspace(params, self.batch_size)
-        noise_buffer = ops.empty_like(workspace.history) if self.history_noise else None
-        average = ParameterAverage()
-        start = time.perf_counter()
-        for epoch in range(n_epochs):
-            rng = rng_from(self.random_state_)
-            # minibatches are planned with numpy; the math draws on X's device
-            math_rng = array_random(rng, X)
-            momentum = self.momentum if self.n_iter_ >= self.momentum_delay else 0.0
-            squared_error = 0.0
-            batches = plan_batches(frames, self.batch_size, rng)
-            if ops is not np:  # the epoch's plan reaches the device in one copy
-                batches = to_device_batches(batches, ops)
-            for batch in batches:
-                n = batch.shape[0]
-                visible = ops.take(
-                    X, batch, axis=0, out=workspace.visible(n), mode="clip"
-                )
-                batch_history = frame_history(
-                    X, batch, n_lags, out=workspace.history[:n, ...]
-                )
-                if self.history_noise:
-                    add_history_noise(
-                        math_rng,
-                        batch_history,
-                        self.history_noise,
-                        X.shape[1],
-                        self.history_noise_fraction,
-                        noise_buffer[:n, ...],
-                    )
-                _, error = cd_gradients(
-                    params,
-                    visible,
-                    batch_history,
-                    self.cd_steps,
-                    math_rng,
-                    out=update.statistics,
-                    scale=self.learning_rate / n,
-                    workspace=workspace,
-                    centered=self.centering,
-                )
-                squared_error += error
-                update.apply(momentum, self.learning_rate, self.weight_decay)
-                if params.learned_variance:
-                    ops.maximum(
-                        params.log_visible_variance,
-                        MIN_LOG_VARIANCE,
-                        out=params.log_visible_variance,
-                    )
-            squared_error = float(squared_error)  # one device sync per epoch
-            self.n_iter_ += 1
-            self.reconstruction_error_ = squared_error / len(frames)
-            if not params.is_finite() or not math.isfinite(squared_error):
-                self._parameters = self._standard_form(params)
-                raise TrainingDivergedError(
-                    f"Training diverged at epoch {self.n_iter_}: the weights became "
-                    f"non-finite with learning_rate={self.learning_rate}. Lower the "
-                    "learning rate (and momentum), and standardise the data, e.g. "
-                    "with sklearn_crbm.preprocessing.StandardScaler."
-                )
-            if self.verbose and self.n_iter_ % self.verbose == 0:
-                print(
-                    f"[{type(self).__name__}] Iteration {self.n_iter_}, "
-                    f"reconstruction error = {self.reconstruction_error_:.4f}, "
-                    f"time = {time.perf_counter() - start:.2f}s"
-                )
-            if epoch >= n_epochs - n_averaged:
-                average.add(self._standard_form(params))
-        self._parameters = (
-            average.mean if average.count else self._standard_form(params)
-        )
-
-    def _standard_form(self, params):
-        """The trained parameters as the fitted model keeps them (C order)."""
-        params = params.copy(layout="C")
-        return shift_centred(params, -1) if self.centering else params
-
-    def _train_with_early_stopping(self, X, sequences):
-        """Train on some sequences, keep the parameters that score best on the rest."""
-        rng = rng_from(self.random_state_)
-        held = validation_split(sequences, self.validation_fraction, rng)
-        ids = sequences.per_frame_ids()
-        parts = []
-        for mask in (~held, held):
-            part = check_sequence_ids(ids[mask], int(mask.sum()))
-            frames = part.valid_frames(self._n_lags)
-            if len(frames) == 0:
-                raise ValueError(
-                    f"early_stopping: no {'validation' if mask is held else 'training'}"
-                    f" frame has {self._n_lags} past frames in its sequence; pass "
-                    "longer sequences or raise validation_fraction."
-                )
-            rows = np.flatnonzero(mask)
-            parts.append((array_ops(X).take(X, rows, axis=0), part, frames))
-        (X_train, _, train_frames), (X_valid, valid, valid_frames) = parts
-        self._start_autoregressive(X_train, train_frames)
-        # the same random numbers at every check: changes are the model's
-        seed = int(rng.integers(np.iinfo(np.int32).max))
-        self.validation_scores_ = []
-        best, best_iter, best_parameters = -np.inf, 0, None
-        while self.n_iter_ < self.n_iter:
-            epochs = min(self.validation_interval, self.n_iter - self.n_iter_)
-            self._train(X_train, train_frames, epochs)
-            log_likelihood = self._log_likelihood(
-                X_valid, valid, rng=np.random.default_rng(seed)
-            ).log_likelihood
-            ops = array_ops(log_likelihood)
-            score = float(ops.mean(ops.take(log_likelihood, valid_frames, axis=0)))
-            self.validation_scores_.append(score)
-            if score > best + self.tol or best_parameters is None:
-                best, best_iter = float(score), self.n_iter_
-                best_parameters = self._parameters.copy()
-            elif self.n_iter_ - best_iter >= self.n_iter_no_change:
-                break
-        self._parameters = best_parameters
-        self.best_validation_score_ = best
-
-    def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.array_api_support = True
-        return tags
 
     @limit_blas_threads(frame_rows)
     def estimate_log_likelihood(

@@ -50,7 +50,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._crbm_math import BINARY, logistic
+from ._layer import logistic
 from .utils._array_api import array_ops, copy_array
 
 # Hidden configurations summed per block by the exact enumeration.
@@ -68,83 +68,6 @@ _LOG_SQRT_2PI = 0.5 * math.log(2 * math.pi)
 # times the per-frame distributions, from this many frames at most.
 SHARED_STEPS = 5
 SHARED_STARTS = 256
-
-
-class FrameRBMs:
-    """The RBMs of a set of frames: shared weights, one pair of biases per frame.
-
-    Parameters
-    ----------
-    params : CRBMParameters
-        Only its weights and visible type are used.
-    visible_bias, hidden_bias : ndarray of shape (n, n_features), (n, n_components)
-        The dynamic biases ``c_hat`` and ``b_hat`` of every frame.
-    scale : ndarray of shape (n_features,), default=None
-        Standard deviation of the Gaussian visibles; ``None`` means ones.
-        Ignored for binary visibles.
-
-    Everything is computed in float64: AIS sums many small log ratios.
-    """
-
-    def __init__(self, params, visible_bias, hidden_bias, scale=None):
-        self.binary = params.visible_type == BINARY
-        self.ops = ops = params.ops
-        self.weights = ops.asarray(params.weights, dtype=ops.float64)
-        self.visible_bias = ops.asarray(visible_bias, dtype=ops.float64)
-        self.hidden_bias = ops.asarray(hidden_bias, dtype=ops.float64)
-        n_features = self.weights.shape[1]
-        if self.binary or scale is None:
-            scale = ops.ones(n_features, dtype=ops.float64)
-        self.scale = ops.asarray(scale, dtype=ops.float64)
-
-    @property
-    def n_frames(self):
-        return self.visible_bias.shape[0]
-
-    @property
-    def n_components(self):
-        return self.weights.shape[0]
-
-    @property
-    def n_features(self):
-        return self.weights.shape[1]
-
-    def take(self, rows):
-        """The RBMs of frames ``rows`` (an index array or a slice)."""
-        new = object.__new__(FrameRBMs)
-        new.__dict__.update(self.__dict__)
-        if isinstance(rows, slice):
-            new.visible_bias = self.visible_bias[rows, ...]
-            new.hidden_bias = self.hidden_bias[rows, ...]
-        else:
-            new.visible_bias = self.ops.take(self.visible_bias, rows, axis=0)
-            new.hidden_bias = self.ops.take(self.hidden_bias, rows, axis=0)
-        return new
-
-    def hidden_input(self, visible, hidden_bias=None):
-        """``b_hat + W (v / s)`` for rows of ``visible``."""
-        hidden_bias = self.hidden_bias if hidden_bias is None else hidden_bias
-        return (visible / self.scale) @ self.weights.T + hidden_bias
-
-    def negative_free_energy(self, visible):
-        """``-F(v)`` of every frame's own row of ``visible``."""
-        ops = self.ops
-        softplus = ops.sum(ops.logaddexp(0, self.hidden_input(visible)), axis=1)
-        if self.binary:
-            return ops.einsum("ij,ij->i", visible, self.visible_bias) + softplus
-        residual = (visible - self.visible_bias) / self.scale
-        return softplus - 0.5 * ops.einsum("ij,ij->i", residual, residual)
-
-    def gaussian_normaliser(self):
-        """``sum_i log(sqrt(2 pi) s_i)``: the visible integral's constant."""
-        return (
-            0.0
-            if self.binary
-            else float(
-                self.ops.sum(self.ops.log(self.scale))
-                + (self.n_features * _LOG_SQRT_2PI)
-            )
-        )
 
 
 class LogLikelihood(NamedTuple):
@@ -203,20 +126,46 @@ def log_partition_exact(rbms):
     if rbms.binary:  # the softplus term is (frames, block, features)
         block = max(1, min(block, (1 << 22) // max(1, rbms.n_frames * rbms.n_features)))
     ops = rbms.ops
+    weights = rbms.shared_weights
     log_z = ops.full(rbms.n_frames, -math.inf, dtype=ops.float64)
     for start in range(0, total, block):
         stop = min(start + block, total)
         hidden = hidden_configurations(n_components, start, stop, ops)
-        u = hidden @ rbms.weights  # (configs, n_features)
-        terms = rbms.hidden_bias @ hidden.T
-        if rbms.binary:
-            softplus = ops.logaddexp(0, rbms.visible_bias[:, None, :] + u)
-            terms += ops.sum(softplus, axis=2)
+        if weights is not None:  # one u = W.T h per configuration for all frames
+            terms = _configuration_terms(rbms, hidden, hidden @ weights)
         else:
-            terms += (rbms.visible_bias / rbms.scale) @ u.T
-            terms += 0.5 * ops.einsum("ij,ij->i", u, u)
+            terms = ops.concatenate(
+                [
+                    _own_configuration_terms(rbms, row, hidden)
+                    for row in range(rbms.n_frames)
+                ]
+            )
         log_z = ops.logaddexp(log_z, _logsumexp_rows(terms))
     return log_z + rbms.gaussian_normaliser()
+
+
+def _configuration_terms(rbms, hidden, u):
+    """``log sum_v exp(-E(v, h))`` up to the normaliser, frames x configurations.
+
+    ``u`` holds ``W.T h`` of every configuration (shape ``(configs,
+    n_features)``), the same for every frame of ``rbms``.
+    """
+    ops = rbms.ops
+    terms = rbms.hidden_bias @ hidden.T
+    if rbms.binary:
+        softplus = ops.logaddexp(0, rbms.visible_bias[:, None, :] + u)
+        terms += ops.sum(softplus, axis=2)
+    else:
+        terms += (rbms.visible_bias / rbms.scale) @ u.T
+        terms += 0.5 * ops.einsum("ij,ij->i", u, u)
+    return terms
+
+
+def _own_configuration_terms(rbms, row, hidden):
+    """:func:`_configuration_terms` of frame ``row``, whose ``W_t`` is its own."""
+    repeated = rbms.take(np.full(hidden.shape[0], row))
+    u = repeated.interaction_field(hidden) / rbms.scale
+    return _configuration_terms(rbms.take(slice(row, row + 1)), hidden, u)
 
 
 def _logsumexp_rows(values):
@@ -259,7 +208,7 @@ def mean_field_base(rbms, start=None, n_steps=_MEAN_FIELD_STEPS):
     for _ in range(n_steps):
         visible = logistic(field) if rbms.binary else field
         hidden = logistic(rbms.hidden_input(visible))
-        field = rbms.visible_bias + rbms.scale * (hidden @ rbms.weights)
+        field = rbms.visible_bias + rbms.interaction_field(hidden)
     if rbms.binary:
         field = _logit(logistic(field))
     return field, _logit(hidden)
@@ -319,8 +268,8 @@ class _Annealing:
         self.gradient = rows_of(gradient)
         self.hidden_logits = rows_of(hidden_logits)
         self.input_offset = rows_of(rbms.hidden_bias - hidden_logits)  # b_hat - a
-        self.input_weights = ops.ascontiguousarray((rbms.weights / scale).T, self.dtype)
-        self.field_weights = ops.ascontiguousarray(rbms.weights * scale, self.dtype)
+        # every row's interaction (its frame's, one row per chain)
+        self.rbms = rbms.take(rows).astype(self.dtype)
         n_hidden = rbms.n_components
         self.difference = ops.empty((self.n_rows, n_hidden), self.dtype)
         self.logits = ops.empty_like(self.difference)
@@ -341,7 +290,7 @@ class _Annealing:
         (``beta``) and :attr:`previous` (``previous_beta``).
         """
         ops = self.ops
-        difference = ops.matmul(visible, self.input_weights, out=self.difference)
+        difference = self.rbms.interaction_input(visible, out=self.difference)
         difference += self.input_offset
         logits = ops.multiply(difference, beta, out=self.logits)
         logits += self.hidden_logits
@@ -358,7 +307,7 @@ class _Annealing:
     def gibbs(self, beta, logits, rng):
         """A block-Gibbs step at ``beta`` from hidden logits ``a + beta d(v)``."""
         hidden = _bernoulli(logistic(logits, out=self.work), rng)
-        field = self.ops.matmul(hidden, self.field_weights)
+        field = self.rbms.interaction_field(hidden)
         field += self.shift
         field *= beta
         field += self.visible_base
@@ -573,11 +522,10 @@ def _shared_log_partition(rbms, frames, method, n_steps, n_chains, rng):
 
 
 def frame_log_likelihood(
-    params,
-    scale,
     visible,
     chunks,
     *,
+    shared=False,
     method="auto",
     n_steps=50,
     n_chains=2,
@@ -588,21 +536,20 @@ def frame_log_likelihood(
 
     Parameters
     ----------
-    params : CRBMParameters
-    scale : ndarray of shape (n_features,) or None
-        Standard deviation of the Gaussian visibles (None: ones).
     visible : ndarray of shape (n_frames, n_features)
         The frames, indexed by the rows of ``chunks``.
-    chunks : iterable of (rows, visible_bias, hidden_bias)
-        The frames' dynamic biases, as an estimator's
-        ``_iter_dynamic_biases`` yields them.
+    chunks : iterable of (rows, FrameRBMs)
+        The frames' RBMs, as :func:`~sklearn_crbm._layer.sequence_frame_rbms`
+        yields them.
+    shared : bool, default=False
+        Whether every frame has the same RBM (a layer without history or
+        context): its one partition function is annealed once
+        (:func:`shared_log_partition_ais`) with ``SHARED_STEPS * n_steps``
+        distributions and ``n_chains`` chains from each of up to
+        ``SHARED_STARTS`` frames.
     method : {"auto", "exact", "ais"}, default="auto"
     n_steps, n_chains : int, default=50, 2
-        AIS intermediate distributions and chains per frame.  A model
-        without history (``n_lags == 0``) has one partition function for
-        every frame; it is annealed once (:func:`shared_log_partition_ais`)
-        with ``SHARED_STEPS * n_steps`` distributions and ``n_chains``
-        chains from each of up to ``SHARED_STARTS`` frames.
+        AIS intermediate distributions and chains per frame.
     reverse : bool, default=False
         Also run reverse annealing (RAISE), a conservative estimate.
     rng : numpy.random.Generator
@@ -612,10 +559,10 @@ def frame_log_likelihood(
     LogLikelihood
     """
     rng = np.random.default_rng() if rng is None else rng
-    ops = params.ops
+    ops = array_ops(visible)
     with np.errstate(under="ignore"):  # exp of very negative numbers is 0
         parts = _chunk_log_likelihoods(
-            params, scale, visible, chunks, method, n_steps, n_chains, reverse, rng
+            visible, chunks, shared, method, n_steps, n_chains, reverse, rng
         )
     return LogLikelihood(
         ops.concatenate([p[0] for p in parts]),
@@ -626,28 +573,28 @@ def frame_log_likelihood(
 
 
 def _chunk_log_likelihoods(
-    params, scale, visible, chunks, method, n_steps, n_chains, reverse, rng
+    visible, chunks, shared, method, n_steps, n_chains, reverse, rng
 ):
-    shared = None
+    shared_partition = None
     parts = []
-    for rows, visible_bias, hidden_bias in chunks:
-        rbms = FrameRBMs(params, visible_bias, hidden_bias, scale)
-        if params.n_lags == 0:
-            if shared is None:
-                shared = _shared_log_partition(
+    for rows, rbms in chunks:
+        ops = rbms.ops
+        rbms = rbms.astype(ops.float64)  # AIS sums many small log ratios
+        if shared:
+            if shared_partition is None:
+                shared_partition = _shared_log_partition(
                     rbms,
-                    rbms.ops.take(visible, rows, axis=0),
+                    ops.take(visible, rows, axis=0),
                     method,
                     n_steps,
                     n_chains,
                     rng,
                 )
-            log_z, error, used = shared
+            log_z, error, used = shared_partition
         else:
             log_z, error, used = log_partition(
                 rbms, method=method, n_steps=n_steps, n_chains=n_chains, rng=rng
             )
-        ops = rbms.ops
         frames = ops.astype(ops.take(visible, rows, axis=0), ops.float64)
         log_likelihood = rbms.negative_free_energy(frames) - log_z
         lower = None
@@ -663,10 +610,10 @@ def _chunk_log_likelihoods(
 # ------------------------------------------------------------------ stacks
 
 
-def stack_log_likelihood_bound(layers, visible, biases, *, n_samples, rng, **top):
-    """A lower bound on ``log p(v_t | history)`` under a stack of CRBMs.
+def stack_log_likelihood_bound(stack, visible, *, n_samples, rng, **top):
+    """A lower bound on ``log p(v_t | history)`` under a stack of layers.
 
-    The stack generates a frame top-down: the top CRBM gives the units of
+    The stack generates a frame top-down: the top layer gives the units of
     the layer below it, each lower layer's conditional ``p_l(h_{l-1} |
     h_l)`` the layer below, down to the frame.  With every lower layer's
     posterior ``q_l(h_l | h_{l-1})`` (its hidden probabilities, as in
@@ -677,17 +624,15 @@ def stack_log_likelihood_bound(layers, visible, biases, *, n_samples, rng, **top
         log mean_s exp(sum_l [log p_l(h_{l-1} | h_l) - log q_l(h_l | h_{l-1})]
                        + log p_top(h_{L-1} | history))
 
-    low on average by Jensen's inequality, whose top term is the top CRBM's
+    low on average by Jensen's inequality, whose top term is the top layer's
     exact or annealed log-likelihood.
 
     Parameters
     ----------
-    layers : list of (CRBMParameters, scale)
-        Bottom first; ``scale`` is the bottom layer's visible standard
-        deviation (or None).
+    stack : list of FrameRBMs
+        Bottom first: every layer's RBMs of these frames, given its own
+        history.
     visible : ndarray of shape (n_frames, n_features)
-    biases : list of (visible_bias, hidden_bias)
-        Every layer's dynamic biases for these frames, from its own history.
     n_samples : int
     rng : numpy.random.Generator
     **top
@@ -703,23 +648,16 @@ def stack_log_likelihood_bound(layers, visible, biases, *, n_samples, rng, **top
     rows = np.repeat(np.arange(n_frames), n_samples)
     state = ops.astype(ops.take(visible, rows, axis=0), ops.float64)
     log_weight = ops.zeros(len(rows), dtype=ops.float64)
+    stack = [rbms.astype(ops.float64) for rbms in stack]
     with np.errstate(under="ignore"):
-        for (params, scale), (visible_bias, hidden_bias) in zip(
-            layers[:-1], biases[:-1], strict=True
-        ):
-            rbms = FrameRBMs(
-                params,
-                ops.take(visible_bias, rows, axis=0),
-                ops.take(hidden_bias, rows, axis=0),
-                scale,
-            )
+        for rbms in stack[:-1]:
+            rbms = rbms.take(rows)
             logits = rbms.hidden_input(state)
             hidden = _bernoulli(logistic(copy_array(logits)), rng)
             log_weight -= ops.sum(hidden * logits - ops.logaddexp(0, logits), axis=1)
             log_weight += _log_visible_given_hidden(rbms, state, hidden)
             state = hidden
-        params, scale = layers[-1]
-        top_rbms = FrameRBMs(params, *biases[-1], scale)
+        top_rbms = stack[-1]
         log_z, _, _ = log_partition(top_rbms, rng=rng, **top)
         top_term = top_rbms.take(rows).negative_free_energy(state)
         log_weight += top_term - ops.take(log_z, rows)
@@ -729,11 +667,11 @@ def stack_log_likelihood_bound(layers, visible, biases, *, n_samples, rng, **top
 def _log_visible_given_hidden(rbms, visible, hidden):
     """``log p(v | h)`` per row: ``N(c_hat + s W.T h, s^2)`` or Bernoulli."""
     ops = rbms.ops
-    field = hidden @ rbms.weights
+    field = rbms.interaction_field(hidden)
     if rbms.binary:
         field += rbms.visible_bias
         return ops.sum(visible * field - ops.logaddexp(0, field), axis=1)
-    residual = (visible - rbms.visible_bias) / rbms.scale - field
+    residual = (visible - rbms.visible_bias - field) / rbms.scale
     return (
         -0.5 * ops.einsum("ij,ij->i", residual, residual) - rbms.gaussian_normaliser()
     )

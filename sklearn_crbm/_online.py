@@ -2,7 +2,7 @@
 
 :meth:`ConditionalRBM.sample`, :meth:`StackedCRBM.sample` and
 :class:`~sklearn_crbm.impute.CRBMImputer` all call :func:`run_online`, with
-one layer or a stack:
+one layer or a stack, of any kind (:mod:`sklearn_crbm._layer`):
 
 - generation: nothing observed, every frame of every sequence drawn from a
   seed history;
@@ -10,40 +10,48 @@ one layer or a stack:
   sequence (``n_draws * n_particles``), particles resampled before every
   frame, and a sequence's first frame filled from itself as its own past.
 
+The loop is written once for numpy and every array API namespace: every
+sequence advances at every step (a sequence that has ended repeats its last
+frame, a draw its caller ignores), and what differs between sequences is
+masked, never scattered, so nothing is indexed on a device but whole axes.
 :class:`History` keeps the recent past of every chain at every layer and
-gives the dynamic biases of the next frame.
+gives the frame RBMs of the next frame.
 """
 
 from dataclasses import dataclass
 from numbers import Real
 
 import numpy as np
-from sklearn.utils._array_api import _convert_to_numpy
 
-from ._crbm_math import (
-    BINARY,
-    dynamic_biases,
+from ._gibbs import (
     gibbs_frames,
-    hidden_probabilities,
     observed_log_likelihood,
-    sequence_hidden_probabilities,
     stacked_gibbs_frames,
     stacked_prediction,
-    visible_means,
 )
-from .utils._array_api import copy_array
+from ._layer import sequence_hidden_probabilities
+from .utils._array_api import array_ops, copy_array, to_numpy
 from .utils._sequences import Sequences
+
+__all__ = [
+    "TOP_LAYER",
+    "WHOLE_STACK",
+    "History",
+    "Observed",
+    "collect_fills",
+    "run_online",
+]
 
 # How a stack draws a frame (``scheme`` of run_online).  With one layer the two
 # are the same alternating Gibbs run of that layer.
 TOP_LAYER = "top_layer"
-"""The original two-level generation (Taylor's ``gen2.m``): Gibbs sampling in
-the top layer given its own past, then one deterministic pass down (each
-layer's visible means given its own past).  Every layer's past is the values
-that pass produced.  Nothing can be clamped: the data sit at the bottom."""
+"""The original two-level generation: Gibbs sampling in the top layer given
+its own past, then one deterministic pass down (each layer's visible means
+given its own past).  Every layer's past is the values that pass produced.
+Nothing can be clamped: the data sit at the bottom."""
 WHOLE_STACK = "whole_stack"
 """Every Gibbs iteration goes up the stack and down again
-(:func:`~sklearn_crbm._crbm_math.stacked_gibbs_frames`), so the state of the
+(:func:`~sklearn_crbm._gibbs.stacked_gibbs_frames`), so the state of the
 chain is the frame itself and its observed channels can be clamped.  The
 upper layers' past is the final frame passed up (hidden probabilities)."""
 
@@ -59,26 +67,33 @@ class History:
 
     Parameters
     ----------
-    layers : list of CRBMParameters
+    layers : list of ConditionalLayer
         Bottom first.
     windows : list of ndarray
         One per layer, of shape ``(n_chains, n_sequences, n_slots,
         n_visible)`` with ``n_slots = max(n_lags, 1)``: the layer's last
         visible values, most recent first (the frames for the bottom layer,
         the layer below's hidden probabilities above it).
+    context : ndarray of shape (n_chains, n_sequences, n_context), default=None
+        Each chain's own context, used when a step gives none (it follows
+        the chain's past when particles are resampled).
     """
 
-    def __init__(self, layers, windows):
+    def __init__(self, layers, windows, context=None):
         self.layers = layers
         self.windows = windows
+        self.context = context
         self._ops = layers[0].ops
-        # the static biases of a model that does not change while it runs
-        self._static = [
-            self._ops.concatenate((p.visible_bias, p.hidden_bias)) for p in layers
-        ]
+        # the frame RBMs of a model that does not change while it runs
+        self._conditioners = [layer.conditioner() for layer in layers]
+
+    @property
+    def shape(self):
+        """``(n_chains, n_sequences)``."""
+        return tuple(self.windows[0].shape[:2])
 
     @classmethod
-    def from_frames(cls, layers, frames):
+    def from_frames(cls, layers, frames, context=None):
         """The past made of ``frames``, passed up the layers with edge padding.
 
         Parameters
@@ -90,101 +105,107 @@ class History:
             :meth:`ConditionalRBM.transform` does), and keeps those with a
             full past at layer ``k`` (at least the last one).  A window
             longer than what a layer keeps repeats the oldest kept value.
+        context : ndarray of shape (n_chains, n_sequences, n_context), default=None
+            Every chain's context, the same for all its frames.
         """
         n_chains, n_sequences = frames.shape[:2]
         ops = layers[0].ops
         windows = []
         values = frames
-        for k, params in enumerate(layers):
+        for k, layer in enumerate(layers):
             n_frames = values.shape[2]
-            n_slots = max(params.n_lags, 1)
+            n_slots = max(layer.n_lags, 1)
             picks = np.maximum(np.arange(n_frames - 1, n_frames - 1 - n_slots, -1), 0)
             windows.append(ops.ascontiguousarray(ops.take(values, picks, axis=2)))
             if k + 1 < len(layers):
                 flat = ops.reshape(values, (-1, values.shape[3]))
-                lengths = np.full(n_chains * n_sequences, n_frames, dtype=np.intp)
+                n_rows = n_chains * n_sequences
                 sequences = Sequences(
                     starts=np.arange(0, flat.shape[0], n_frames, dtype=np.intp),
-                    lengths=lengths,
-                    ids=np.arange(len(lengths)),
+                    lengths=np.full(n_rows, n_frames, dtype=np.intp),
+                    ids=np.arange(n_rows),
                 )
-                hidden = sequence_hidden_probabilities(params, flat, sequences)
+                frame_context = None
+                if context is not None:
+                    rows = np.repeat(np.arange(n_rows), n_frames)
+                    frame_context = ops.take(
+                        ops.reshape(context, (n_rows, -1)), rows, axis=0
+                    )
+                hidden = sequence_hidden_probabilities(
+                    layer, flat, sequences, frame_context
+                )
                 hidden = ops.reshape(hidden, (n_chains, n_sequences, n_frames, -1))
-                values = hidden[:, :, min(params.n_lags, n_frames - 1) :, ...]
-        return cls(layers, windows)
+                values = hidden[:, :, min(layer.n_lags, n_frames - 1) :, ...]
+        return cls(layers, windows, context)
 
     def select(self, sequences):
         """The past of some sequences only (for a block of work)."""
         ops = self._ops
+        context = self.context
+        if context is not None:
+            context = ops.take(context, sequences, axis=1)
         return History(
-            self.layers, [ops.take(w, sequences, axis=1) for w in self.windows]
+            self.layers,
+            [ops.take(w, sequences, axis=1) for w in self.windows],
+            context,
         )
 
-    def previous(self, level, sequences):
-        """The last values at ``level`` of ``sequences``: (n_chains, n, n_visible).
+    def previous(self, level):
+        """The last values at ``level``, ``(n_chains, n_sequences, n_visible)``."""
+        return self.windows[level][:, :, 0, ...]
 
-        ``sequences`` (here and below) is an index array, or a slice.
+    def frame_rbms(self, context=None):
+        """Every layer's frame RBMs for the next frame of every chain.
+
+        ``context`` (shape ``(n_sequences, n_context)``, or with a leading
+        chain axis) is the frame's; None uses the chains' own
+        :attr:`context`.  The RBMs have one row per chain and sequence,
+        chain-major.
         """
-        return self.windows[level][:, sequences, 0, ...]
-
-    def biases(self, sequences):
-        """Every layer's dynamic biases for the next frame of ``sequences``.
-
-        Returns a list of arrays of shape ``(n_chains, len(sequences),
-        n_visible + n_hidden)``: the visible biases, then the hidden ones.
-        """
-        biases = []
-        for params, window, static in zip(
-            self.layers, self.windows, self._static, strict=True
+        ops = self._ops
+        n_chains, n_sequences = self.shape
+        if context is None:
+            context = self.context
+        if context is not None:
+            context = ops.broadcast_to(
+                context, (n_chains, n_sequences, context.shape[-1])
+            )
+            context = ops.reshape(context, (n_chains * n_sequences, -1))
+        stack = []
+        for layer, window, conditioner in zip(
+            self.layers, self.windows, self._conditioners, strict=True
         ):
-            ops = self._ops
-            past = window[:, sequences, ...]
-            n_chains, n_rows = past.shape[:2]
-            flat = ops.reshape(past, (n_chains * n_rows, -1))
-            flat = flat[:, : params.n_lags * params.n_features]
-            both = ops.empty((n_chains, n_rows, static.shape[0]), params.dtype)
-            rows = ops.reshape(both, (flat.shape[0], -1))
-            dynamic_biases(params, flat, out=rows, static=static)
-            biases.append(both)
-        return biases
+            past = ops.reshape(window, (n_chains * n_sequences, -1))
+            past = past[:, : layer.n_lags * layer.n_features]
+            stack.append(conditioner(past, context))
+        return stack
 
-    def push(self, values, sequences, biases):
-        """Append a new frame of ``sequences`` at every layer.
+    def push(self, values, stack):
+        """Append a new frame of every chain at every layer.
 
         ``values`` holds the frame's value at the lowest layers, bottom
         first (at least the frame itself); the layers above get the hidden
-        probabilities of the layer below, given ``biases`` (from
-        :meth:`biases` for this frame).
+        probabilities of the layer below, given ``stack`` (from
+        :meth:`frame_rbms` for this frame).
         """
         ops = self._ops
-        if len(values) < len(self.layers):
-            values = list(values)
+        values = list(values)
         for k in range(len(values), len(self.layers)):
-            params = self.layers[k - 1]
             below = values[-1]
-            hidden_bias = biases[k - 1][..., params.n_features :]
-            flat = hidden_probabilities(
-                params,
-                ops.reshape(below, (-1, params.n_features)),
-                ops.reshape(hidden_bias, (-1, params.n_components)),
+            flat = stack[k - 1].hidden_probabilities(
+                ops.reshape(below, (-1, below.shape[-1]))
             )
             values.append(ops.reshape(flat, (*below.shape[:2], -1)))
         for window, value in zip(self.windows, values, strict=True):
             # a copy: the array API leaves overlapping assignment undefined
-            window[:, sequences, 1:, ...] = copy_array(window[:, sequences, :-1, ...])
-            window[:, sequences, 0, ...] = value
+            window[:, :, 1:, ...] = copy_array(window[:, :, :-1, ...])
+            window[:, :, 0, ...] = value
 
-    def reorder(self, chains, sequences):
-        """Give chain ``i`` of each of ``sequences`` the past of chain ``chains[i]``.
-
-        ``chains`` has shape ``(n_chains, len(sequences))``; off numpy,
-        ``sequences`` is every sequence (a slice).
-        """
-        if self._ops is not np:
-            self.windows = [_take_chains(self._ops, w, chains) for w in self.windows]
-            return
-        for window in self.windows:
-            window[:, sequences] = window[chains, sequences[None, :]]
+    def reorder(self, chains):
+        """Give chain ``i`` of sequence ``s`` the past of chain ``chains[i, s]``."""
+        self.windows = [_take_chains(self._ops, w, chains) for w in self.windows]
+        if self.context is not None:
+            self.context = _take_chains(self._ops, self.context, chains)
 
 
 @dataclass(frozen=True)
@@ -199,11 +220,14 @@ class Observed:
         mean).
     missing : ndarray of bool of shape (n_frames, n_features)
     sequences : Sequences
+    context : ndarray of shape (n_frames, n_context), default=None
+        Every frame's context, for a model that uses one.
     """
 
     X: np.ndarray
     missing: np.ndarray
     sequences: Sequences
+    context: np.ndarray = None
 
 
 class Offsets:
@@ -213,19 +237,19 @@ class Offsets:
     typical values (a slow posture channel towards the training posture);
     while a channel is observed, its one-step residual ``r_t = x_t -
     x_hat_t`` (``x_hat_t`` the chain's mean-field prediction of the frame
-    from its past, :func:`~sklearn_crbm._crbm_math.stacked_prediction`)
-    shows that error.  The correction of a missing entry is the posterior
-    mean of a constant offset ``d`` behind the residuals, ``r_t = d +
-    noise``, with a prior worth ``shrinkage`` frames of zero residual:
-    ``sum(r) / (n + shrinkage)`` over the ``n`` frames of the sequence in
-    which the channel was observed so far (counted from the model's order
-    on: earlier frames have an edge-padded past).  Binary visibles' fills
-    are probabilities, and stay in [0, 1].
+    from its past, :func:`~sklearn_crbm._gibbs.stacked_prediction`) shows
+    that error.  The correction of a missing entry is the posterior mean of
+    a constant offset ``d`` behind the residuals, ``r_t = d + noise``, with a
+    prior worth ``shrinkage`` frames of zero residual: ``sum(r) / (n +
+    shrinkage)`` over the ``n`` frames of the sequence in which the channel
+    was observed so far (counted from the model's order on: earlier frames
+    have an edge-padded past).  Binary visibles' fills are probabilities,
+    and stay in [0, 1].
 
     Parameters
     ----------
     n_chains, n_sequences : int
-    bottom : CRBMParameters
+    bottom : ConditionalLayer
         The bottom layer (its number of features and visible type).
     shrinkage : float
     dtype : dtype
@@ -236,34 +260,29 @@ class Offsets:
         self.sums = ops.zeros((n_chains, n_sequences, bottom.n_features), dtype)
         self.counts = ops.zeros((n_sequences, bottom.n_features), dtype)
         self.shrinkage = shrinkage
-        self.binary = bottom.visible_type == BINARY
+        self.binary = bottom.binary
 
-    def update(self, prediction, sequences, frames, observed):
+    def update(self, prediction, frames, observed):
         """Add the residuals of ``frames`` (one per sequence) where ``observed``.
 
-        ``prediction`` is every chain's one-step prediction of the frames
-        (:func:`_one_step_predictions`), of shape ``(n_chains, *frames.shape)``.
+        ``prediction`` is every chain's one-step prediction of the frames,
+        of shape ``(n_chains, *frames.shape)``.
         """
         ops = self._ops
-        self.sums[:, sequences, ...] += ops.where(observed, frames - prediction, 0)
-        self.counts[sequences, ...] += ops.astype(observed, self.counts.dtype)
+        self.sums += ops.where(observed, frames - prediction, 0)
+        self.counts += ops.astype(observed, self.counts.dtype)
 
-    def corrected(self, frames, sequences, missing):
-        """Every chain's ``frames`` of ``sequences``, corrected where ``missing``."""
+    def corrected(self, frames, missing):
+        """Every chain's ``frames``, corrected where ``missing``."""
         ops = self._ops
         # a channel never observed has a zero sum; the floor spares 0 / 0
-        denominator = ops.maximum(self.counts[sequences, ...] + self.shrinkage, 1)
-        frames = frames + ops.where(
-            missing, self.sums[:, sequences, ...] / denominator, 0
-        )
+        denominator = ops.maximum(self.counts + self.shrinkage, 1)
+        frames = frames + ops.where(missing, self.sums / denominator, 0)
         return ops.clip(frames, 0, 1) if self.binary else frames
 
-    def reorder(self, chains, sequences):
+    def reorder(self, chains):
         """The chains' offsets follow their pasts (:meth:`History.reorder`)."""
-        if self._ops is not np:
-            self.sums = _take_chains(self._ops, self.sums, chains)
-            return
-        self.sums[:, sequences] = self.sums[chains, sequences[None, :]]
+        self.sums = _take_chains(self._ops, self.sums, chains)
 
 
 def run_online(
@@ -273,6 +292,8 @@ def run_online(
     history=None,
     n_steps=None,
     observed=None,
+    context=None,
+    chain_context=None,
     n_chains=1,
     n_particles=1,
     n_gibbs=30,
@@ -291,9 +312,9 @@ def run_online(
 
     Parameters
     ----------
-    layers : list of CRBMParameters
+    layers : list of ConditionalLayer
         The model, bottom layer first.
-    rng : numpy.random.Generator
+    rng : numpy.random.Generator or ArrayRandom
     history : History, default=None
         The past the first frame follows (generation).  ``None`` (fill-in
         only) starts every sequence with no past: its first frame is filled
@@ -306,6 +327,12 @@ def run_online(
         its length; only frames with a missing entry are drawn, and their
         observed entries are clamped.  None: generation, every sequence of
         ``history`` draws every entry of ``n_steps`` frames.
+    context : ndarray of shape (n_sequences, n_steps, n_context), default=None
+        Generation: every new frame's context (e.g. style label weights).
+        In fill-in the frames' contexts are ``observed.context``.
+    chain_context : ndarray of shape (n_chains, n_sequences, n_context), default=None
+        Fill-in without ``observed.context``: each chain's own context
+        (hypotheses about it, which particle resampling weighs).
     n_chains : int, default=1
         Chains per sequence (``history``'s, when given).
     n_particles : int, default=1
@@ -330,15 +357,14 @@ def run_online(
         or the top layer with :data:`TOP_LAYER`.
     offset_shrinkage : float, default=None
         Fill-in only.  ``None``: no correction.  A number ``lam >= 0``: each
-        chain's drawn entries are shifted by the chain's
-        :class:`Offsets` correction (its mean one-step residual of that
-        channel in that sequence so far, shrunk by ``lam`` frames).
+        chain's drawn entries are shifted by the chain's :class:`Offsets`
+        correction (its mean one-step residual of that channel in that
+        sequence so far, shrunk by ``lam`` frames).
     observation_gain : float or ndarray of shape (n_features,), default=1.0
         Fill-in only.  The hidden units of a chain see each observed channel
         at ``x_hat + observation_gain * (x - x_hat)`` (a gain per channel if
-        an array) instead of at its value
-        ``x``, ``x_hat`` being the chain's one-step prediction of the frame
-        from its past (:func:`_one_step_predictions`): the observed
+        an array) instead of at its value ``x``, ``x_hat`` being the chain's
+        one-step prediction of the frame from its past: the observed
         channels' surprise counts ``observation_gain`` times.  The frame
         keeps the observed values.  ``1``: the model's own conditional.  A
         sequence's first frame (no past) is filled without it.
@@ -346,20 +372,11 @@ def run_online(
     Yields
     ------
     step : int
-    sequences : ndarray of int
-        The sequences that have a frame at this step.
-    drawn : ndarray of int
-        Indices into ``sequences`` of the frames that were drawn.
-    frames : ndarray of shape (n_chains, len(drawn), n_features)
-        Every chain's draw of those frames (observed entries included).
-
-    Notes
-    -----
-    In fill-in on an array API namespace other than numpy
-    (:func:`_fill_on_device`), every sequence advances at every step, so that
-    nothing is scattered on the device: ``sequences`` and ``drawn`` are all
-    sequences, a sequence that has ended repeats its last frame (a draw to
-    ignore), and a frame without a missing entry comes back as it is.
+    frames : ndarray of shape (n_chains, n_sequences, n_features)
+        Every chain's frame of every sequence at this step, on every
+        backend.  In fill-in, a sequence that has ended repeats its last
+        frame (to be ignored) and a frame with nothing missing comes back as
+        it is.
     """
     if scheme not in (TOP_LAYER, WHOLE_STACK):
         raise ValueError(f"unknown scheme {scheme!r}")
@@ -369,30 +386,25 @@ def run_online(
     if stacked and scheme == WHOLE_STACK and sample_visibles:
         raise ValueError("sample_visibles needs one layer or the top_layer scheme")
 
-    def draw(start, biases, clamp):
-        """One Gibbs run per (chain, frame) pair; the frame's lowest values."""
+    def draw(start, stack, clamp):
+        """One Gibbs run per chain and sequence; the frame's lowest values."""
         shape = start.shape
-        visible_biases, hidden_biases = _split(layers, biases)
-        start = ops.reshape(start, (-1, shape[-1]))
+        flat = [ops.reshape(start, (-1, shape[-1]))]
         clamp = None if clamp is None else ops.reshape(clamp, (-1, shape[-1]))
         if stacked and scheme == WHOLE_STACK:
             frame = stacked_gibbs_frames(
-                layers,
-                start,
-                visible_biases,
-                hidden_biases,
+                stack,
+                flat[0],
                 n_gibbs,
                 rng,
                 hidden_noise=hidden_noise,
                 observed_mask=clamp,
             )
             return [ops.reshape(frame, shape)]
-        values = [
+        flat = [
             gibbs_frames(
-                layers[-1],
-                start,
-                visible_biases[-1],
-                hidden_biases[-1],
+                stack[-1],
+                flat[0],
                 n_gibbs,
                 rng,
                 hidden_noise=hidden_noise,
@@ -400,210 +412,150 @@ def run_online(
                 sample_visibles=sample_visibles,
             )
         ]
-        below = zip(layers[-2::-1], visible_biases[-2::-1], strict=True)
-        for params, visible_bias in below:
-            values.insert(0, visible_means(params, values[0], visible_bias))
-        return [ops.reshape(v, (*shape[:2], -1)) for v in values]
+        for rbms in stack[-2::-1]:
+            flat.insert(0, rbms.visible_mean(flat[0]))
+        return [ops.reshape(v, (*shape[:2], -1)) for v in flat]
 
     ops = layers[0].ops
-    level = len(layers) - 1 if scheme == TOP_LAYER else 0
     if observed is None:
-        sequences = np.arange(history.windows[0].shape[1])
-        every = slice(None)  # all sequences: basic indexing, no gather
+        level = len(layers) - 1 if scheme == TOP_LAYER else 0
         for step in range(n_steps):
-            biases = history.biases(every)
-            start = history.previous(level, every)
+            stack = history.frame_rbms(None if context is None else context[:, step])
+            start = history.previous(level)
             if start_jitter:
                 start = start + start_jitter * rng.standard_normal(
                     start.shape[1:], dtype=start.dtype
                 )
-            values = draw(start, biases, None)
-            yield step, sequences, sequences, values[0]
-            history.push(values, every, biases)
+            values = draw(start, stack, None)
+            yield step, values[0]
+            history.push(values, stack)
         return
+    yield from _fill(
+        layers,
+        rng,
+        draw,
+        observed,
+        n_steps,
+        chain_context=chain_context,
+        n_chains=n_chains,
+        n_particles=n_particles,
+        start_jitter=start_jitter,
+        offset_shrinkage=offset_shrinkage,
+        observation_gain=observation_gain,
+    )
 
-    X, missing, all_sequences = observed.X, observed.missing, observed.sequences
-    amplify = _amplifies(observation_gain)
-    starts, lengths = all_sequences.starts, all_sequences.lengths
-    n_features = X.shape[1]
+
+def _fill(
+    layers,
+    rng,
+    draw,
+    observed,
+    n_steps,
+    *,
+    chain_context,
+    n_chains,
+    n_particles,
+    start_jitter,
+    offset_shrinkage,
+    observation_gain,
+):
+    """The fill-in loop of :func:`run_online`: every sequence, every step.
+
+    Which sequences have a frame with a missing entry at a step is known on
+    the host: a step where none has is not drawn, only pushed; otherwise
+    every sequence draws, a frame with nothing missing being clamped whole
+    (it comes back unchanged, its offset correction being zero where nothing
+    is missing), and only groups of particles whose frame has a missing
+    entry are resampled.
+    """
+    ops = layers[0].ops
+    X, missing, sequences = observed.X, observed.missing, observed.sequences
+    starts, lengths = sequences.starts, sequences.lengths
     n_steps = int(lengths.max(initial=0)) if n_steps is None else n_steps
+    amplify = _amplifies(observation_gain)
     offsets = None
     if offset_shrinkage is not None:
         offsets = Offsets(
             n_chains, len(starts), layers[0], offset_shrinkage, dtype=X.dtype
         )
-    if ops is not np:
-        yield from _fill_on_device(
-            layers,
-            rng,
-            draw,
-            history,
-            observed,
-            n_steps,
-            n_chains=n_chains,
-            n_particles=n_particles,
-            offsets=offsets,
-            start_jitter=start_jitter,
-            observation_gain=observation_gain,
-        )
-        return
-    for step in range(n_steps):
-        sequences = np.flatnonzero(lengths > step)
-        rows = starts[sequences] + step
-        frame_missing = missing[rows]
-        drawn = np.flatnonzero(frame_missing.any(axis=1))
-        frames = X[rows]
-        current = np.broadcast_to(frames, (n_chains, *frames.shape)).copy()
-        clamp = np.broadcast_to(
-            ~frame_missing[drawn], (n_chains, len(drawn), n_features)
-        )
-        if history is None:
-            # No past: the frame stands in for it, and the fill is repeated
-            # with the latest fill as the past.
-            for _ in range(FIRST_FRAME_ROUNDS if len(drawn) else 0):
-                start = current[:, drawn]
-                own_past = History.from_frames(layers, start[:, :, None])
-                biases = own_past.biases(np.arange(len(drawn)))
-                current[:, drawn] = draw(start, biases, clamp)[0]
-            history = History.from_frames(layers, current[:, :, None])
-            yield step, sequences, drawn, current[:, drawn]
-            continue
-        if n_particles > 1 and len(drawn):
-            chains = _ancestors(
-                history,
-                sequences[drawn],
-                frames[drawn],
-                ~frame_missing[drawn],
-                n_particles,
-                rng,
-            )
-            history.reorder(chains, sequences[drawn])
-            if offsets is not None:
-                offsets.reorder(chains, sequences[drawn])
-        biases = history.biases(sequences)
-        prediction = None
-        if offsets is not None or amplify:
-            prediction = _one_step_predictions(layers, biases, frames.shape)
-        if offsets is not None and step >= layers[0].n_lags:
-            offsets.update(prediction, sequences, frames, ~frame_missing)
-        if len(drawn):
-            seen = frames[drawn]
-            if amplify:
-                seen = _amplified(seen, prediction[:, drawn], observation_gain)
-            start = np.where(
-                frame_missing[drawn], history.previous(0, sequences[drawn]), seen
-            )
-            if start_jitter:
-                start += start_jitter * rng.standard_normal(start.shape, start.dtype)
-            current[:, drawn] = draw(start, [b[:, drawn] for b in biases], clamp)[0]
-            if amplify:
-                current[:, drawn] = np.where(
-                    frame_missing[drawn], current[:, drawn], frames[drawn]
-                )
-            if offsets is not None:
-                current[:, drawn] = offsets.corrected(
-                    current[:, drawn], sequences[drawn], frame_missing[drawn]
-                )
-        yield step, sequences, drawn, current[:, drawn]
-        history.push([current], sequences, biases)
-
-
-def _fill_on_device(
-    layers,
-    rng,
-    draw,
-    history,
-    observed,
-    n_steps,
-    *,
-    n_chains,
-    n_particles,
-    offsets,
-    start_jitter,
-    observation_gain,
-):
-    """The fill-in loop of :func:`run_online` off numpy: every sequence, every step.
-
-    The same procedure as the numpy loop, written without scattering into
-    device arrays: every sequence draws every step (a sequence that has ended
-    repeats its last frame), a frame with nothing missing is clamped whole
-    and comes back unchanged (its offset correction is zero where nothing is
-    missing), and only groups of particles whose frame has a missing entry
-    are resampled.  The numpy loop skips those draws, so the random streams
-    differ; the fills agree in distribution.
-    """
-    ops = layers[0].ops
-    X, missing, sequences = observed.X, observed.missing, observed.sequences
-    starts, lengths = sequences.starts, sequences.lengths
-    every = slice(None)
-    amplify = _amplifies(observation_gain)
-    all_sequences = np.arange(len(starts))
-    has_missing = _convert_to_numpy(ops.any(missing, axis=1), ops.xp)
+    row_has_missing = to_numpy(ops.any(missing, axis=1))
+    identity = ops.arange(n_chains, dtype=ops.int64)[:, None]
+    history = None
     for step in range(n_steps):
         rows = starts + np.minimum(step, lengths - 1)
+        drawn = row_has_missing[rows] & (lengths > step)
         frame_missing = ops.take(missing, rows, axis=0)
         frames = ops.take(X, rows, axis=0)
+        context = None
+        if observed.context is not None:
+            context = ops.take(observed.context, rows, axis=0)
         shape = (n_chains, *frames.shape)
         clamp = ops.broadcast_to(~frame_missing, shape)
         current = ops.broadcast_to(frames, shape)
         if history is None:
-            for _ in range(FIRST_FRAME_ROUNDS):
-                own_past = History.from_frames(layers, current[:, :, None, :])
-                current = draw(current, own_past.biases(every), clamp)[0]
-            history = History.from_frames(layers, current[:, :, None, :])
-            yield step, all_sequences, all_sequences, current
+            if drawn.any():
+                # No past: the frame stands in for it, and the fill is
+                # repeated with the latest fill as the past.
+                for _ in range(FIRST_FRAME_ROUNDS):
+                    own_past = History.from_frames(
+                        layers, current[:, :, None, :], chain_context
+                    )
+                    current = draw(current, own_past.frame_rbms(context), clamp)[0]
+            history = History.from_frames(layers, current[:, :, None, :], chain_context)
+            yield step, current
             continue
-        if n_particles > 1:
+        # with a context of their own the chains' every observation is
+        # evidence; otherwise only frames to draw tell particles apart
+        weighed = drawn if chain_context is None else lengths > step
+        if n_particles > 1 and weighed.any():
             chains = _ancestors(
-                history, every, frames, ~frame_missing, n_particles, rng
+                history, context, frames, ~frame_missing, n_particles, rng
             )
-            drawn = ops.asarray(has_missing[rows] & (lengths > step))
-            chains = ops.where(
-                drawn[None, :], chains, ops.arange(n_chains, dtype=ops.int64)[:, None]
-            )
-            history.reorder(chains, every)
+            chains = ops.where(ops.asarray(weighed)[None, :], chains, identity)
+            history.reorder(chains)
             if offsets is not None:
-                offsets.reorder(chains, every)
-        biases = history.biases(every)
+                offsets.reorder(chains)
+        stack = history.frame_rbms(context)
         prediction = None
         if offsets is not None or amplify:
-            prediction = _one_step_predictions(layers, biases, frames.shape)
+            prediction = _one_step_predictions(stack, shape)
         if offsets is not None and step >= layers[0].n_lags:
-            offsets.update(prediction, every, frames, ~frame_missing)
-        seen = frames
-        if amplify:
-            seen = _amplified(frames, prediction, observation_gain)
-        start = ops.where(frame_missing, history.previous(0, every), seen)
-        if start_jitter:
-            start = start + start_jitter * rng.standard_normal(start.shape, start.dtype)
-        current = draw(start, biases, clamp)[0]
-        if amplify:
-            current = ops.where(frame_missing, current, frames)
-        if offsets is not None:
-            current = offsets.corrected(current, every, frame_missing)
-        yield step, all_sequences, all_sequences, current
-        history.push([current], every, biases)
+            offsets.update(prediction, frames, ~frame_missing)
+        if drawn.any():
+            seen = frames
+            if amplify:
+                seen = _amplified(frames, prediction, observation_gain)
+            start = ops.where(frame_missing, history.previous(0), seen)
+            if start_jitter:
+                start = start + start_jitter * rng.standard_normal(
+                    start.shape, start.dtype
+                )
+            current = draw(start, stack, clamp)[0]
+            if amplify:
+                current = ops.where(frame_missing, current, frames)
+            if offsets is not None:
+                current = offsets.corrected(current, frame_missing)
+        yield step, current
+        history.push([current], stack)
 
 
-def _ancestors(history, sequences, frames, observed, n_particles, rng):
+def _ancestors(history, context, frames, observed, n_particles, rng):
     """Resample each group of particles by how well they explain the observed data.
 
     A particle's weight is the likelihood of the frame's observed channels
     under its own one-step prediction
-    (:func:`~sklearn_crbm._crbm_math.observed_log_likelihood`); each group is
+    (:func:`~sklearn_crbm._gibbs.observed_log_likelihood`); each group is
     resampled (systematic resampling).  Returns the ancestors, of shape
     ``(n_chains, n_sequences)``, as :meth:`History.reorder` takes them.
     """
-    layers = history.layers
-    ops = layers[0].ops
-    n_chains = history.windows[0].shape[0]
+    ops = history.layers[0].ops
+    n_chains = history.shape[0]
     n_groups = n_chains // n_particles
     n_sequences, n_features = frames.shape
-    prediction = stacked_prediction(
-        layers, *_split(layers, history.biases(sequences)), PREDICTION_STEPS
-    )
+    stack = history.frame_rbms(context)
+    prediction = stacked_prediction(stack, PREDICTION_STEPS)
     log_weights = observed_log_likelihood(
-        layers[0],
+        stack[0],
         prediction,
         ops.reshape(
             ops.broadcast_to(frames, (n_chains, *frames.shape)), (-1, n_features)
@@ -638,16 +590,15 @@ def _take_chains(ops, array, chains):
     return ops.reshape(ops.take(flat, ops.reshape(index, (-1,)), axis=0), array.shape)
 
 
-def _one_step_predictions(layers, biases, shape):
+def _one_step_predictions(stack, shape):
     """Every chain's mean-field prediction of the next frame from its past.
 
-    ``biases`` from :meth:`History.biases` for ``shape[0]`` sequences of
-    ``shape[1]`` features; returns shape ``(n_chains, *shape)``
-    (:func:`~sklearn_crbm._crbm_math.stacked_prediction`).
+    ``stack`` from :meth:`History.frame_rbms`; returns ``shape``, that is
+    ``(n_chains, n_sequences, n_features)``
+    (:func:`~sklearn_crbm._gibbs.stacked_prediction`).
     """
-    ops = layers[0].ops
-    prediction = stacked_prediction(layers, *_split(layers, biases), PREDICTION_STEPS)
-    return ops.reshape(prediction, (-1, *shape))
+    prediction = stacked_prediction(stack, PREDICTION_STEPS)
+    return stack[0].ops.reshape(prediction, shape)
 
 
 def _amplifies(gain):
@@ -665,11 +616,32 @@ def _amplified(frames, prediction, gain):
     return prediction + gain * (frames - prediction)
 
 
-def _split(layers, biases):
-    """:meth:`History.biases` as two lists of 2-D arrays: visible, hidden."""
-    visible, hidden = [], []
-    for params, both in zip(layers, biases, strict=True):
-        both = params.ops.reshape(both, (-1, both.shape[-1]))
-        visible.append(both[:, : params.n_features])
-        hidden.append(both[:, params.n_features :])
-    return visible, hidden
+def collect_fills(run, sequences, reduce):
+    """The frames of fill-in steps, back in the long format of the data.
+
+    Parameters
+    ----------
+    run : iterator of (step, frames)
+        :func:`run_online`'s fill-in.
+    sequences : Sequences
+    reduce : callable
+        ``reduce(frames)`` turns one step's frames, shape ``(n_chains,
+        n_sequences, n_features)``, into what is kept of them, shape ``(k,
+        n_sequences, n_features)`` (e.g. the mean of each draw's particles).
+
+    Returns
+    -------
+    fills : ndarray of shape (k, n_frames, n_features)
+        Row ``starts[s] + t`` holds step ``t`` of sequence ``s``.
+    """
+    kept = [reduce(frames) for _, frames in run]
+    ops = array_ops(kept[0])
+    n_sequences = len(sequences.starts)
+    index = np.empty(sequences.n_frames, dtype=np.int64)
+    for s, (start, length) in enumerate(
+        zip(sequences.starts, sequences.lengths, strict=True)
+    ):
+        index[start : start + length] = np.arange(length) * n_sequences + s
+    steps = ops.stack(kept, axis=1)
+    steps = ops.reshape(steps, (steps.shape[0], -1, steps.shape[-1]))
+    return ops.take(steps, index, axis=1)

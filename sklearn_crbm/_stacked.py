@@ -135,12 +135,31 @@ class StackedCRBM(BaseCRBM):
 
     _added_parameters = {"history_noise_fraction": 1.0, "average_fraction": 0.0}
 
+    # The hyper-parameters every layer takes from the stack as they are.
+    _layer_parameters = (
+        "order",
+        "hidden_order",
+        "learning_rate",
+        "momentum",
+        "momentum_delay",
+        "weight_decay",
+        "cd_steps",
+        "batch_size",
+        "batching",
+        "history_noise_fraction",
+        "average_fraction",
+        "n_iter",
+        "verbose",
+    )
+
     _parameter_constraints: dict = {
-        **BaseCRBM._parameter_constraints,
+        **{
+            name: ConditionalRBM._parameter_constraints[name]
+            for name in _layer_parameters
+        },
         "n_components": [Interval(Integral, 1, None, closed="left"), "array-like"],
         "history_noise": [Interval(Real, 0, None, closed="left"), "array-like"],
-        "history_noise_fraction": [Interval(Real, 0, 1, closed="right")],
-        "average_fraction": [Interval(Real, 0, 1, closed="left")],
+        "random_state": ["random_state"],
     }
 
     def __init__(
@@ -222,24 +241,13 @@ class StackedCRBM(BaseCRBM):
         return [float(v) for v in values]
 
     def _new_layer(self, n_components, visible_type, seed, history_noise):
+        params = self.get_params(deep=False)
         return ConditionalRBM(
             n_components,
-            order=self.order,
-            hidden_order=self.hidden_order,
             visible_type=visible_type,
-            learning_rate=self.learning_rate,
-            momentum=self.momentum,
-            momentum_delay=self.momentum_delay,
-            weight_decay=self.weight_decay,
-            cd_steps=self.cd_steps,
-            batch_size=self.batch_size,
-            batching=self.batching,
             history_noise=history_noise,
-            history_noise_fraction=self.history_noise_fraction,
-            average_fraction=self.average_fraction,
-            n_iter=self.n_iter,
             random_state=seed,
-            verbose=self.verbose,
+            **{name: params[name] for name in self._layer_parameters},
         )
 
     def _check_fit_input(self, X, sequence_ids, reset):
@@ -249,9 +257,7 @@ class StackedCRBM(BaseCRBM):
         X = validate_data(
             self,
             X,
-            dtype=[xp.float64, xp.float32]
-            if reset
-            else self._layer_parameters()[0].dtype,
+            dtype=[xp.float64, xp.float32] if reset else self._layers()[0].dtype,
             reset=reset,
         )
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
@@ -364,8 +370,8 @@ class StackedCRBM(BaseCRBM):
         )
         return self
 
-    def _layer_parameters(self):
-        return [p for layer in self.layers_ for p in layer._layer_parameters()]
+    def _layers(self):
+        return [layer for model in self.layers_ for layer in model._layers()]
 
     def _chain_rng(self, rng):
         # the top layer's chains draw from a generator of their own, seeded

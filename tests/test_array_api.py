@@ -33,14 +33,10 @@ from sklearn_crbm import (
     NearestNeighborImputer,
     StackedCRBM,
 )
-from sklearn_crbm._crbm_math import (
-    CRBMParameters,
-    MomentumUpdate,
-    cd_gradients,
-    dynamic_biases,
-    gibbs_frames,
-)
+from sklearn_crbm._crbm_layer import CRBMLayer
+from sklearn_crbm._gibbs import gibbs_frames
 from sklearn_crbm._online import History, _ancestors
+from sklearn_crbm._parameters import MomentumUpdate
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.utils._array_api import ArrayRandom, array_ops
 
@@ -64,6 +60,23 @@ COMBINATIONS = [
 ]
 # The namespaces other than numpy itself
 DEVICE_COMBINATIONS = [c for c in COMBINATIONS if c[0] != "numpy"]
+
+
+@pytest.fixture(autouse=True)
+def one_torch_thread():
+    """One PyTorch thread: on a busy machine each elementwise operation of a
+    small array otherwise waits milliseconds for its second thread."""
+    if importlib.util.find_spec("torch") is None:
+        yield
+        return
+    import torch
+
+    threads = torch.get_num_threads()
+    torch.set_num_threads(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(threads)
 
 
 @pytest.fixture
@@ -176,9 +189,9 @@ def _strict_and_numpy_streams(seed, ops):
 def test_training_step_matches_numpy_given_the_same_random_stream():
     xp, device = _array_api_for_tests("array_api_strict", "CPU_DEVICE", "float64")
     rng = np.random.default_rng(0)
-    params = CRBMParameters.initialize(
-        5, 7, 2, 1, "gaussian", np.float64, rng, learned_variance=True
-    )
+    params = CRBMLayer(
+        5, 7, 2, 1, "gaussian", np.float64, learned_variance=True
+    ).initialize(rng)
     moved = params.__sklearn_array_api_convert__(lambda a: _to(xp, device, a))
     visible = rng.standard_normal((20, 5))
     history = rng.standard_normal((20, 10))
@@ -190,7 +203,16 @@ def test_training_step_matches_numpy_given_the_same_random_stream():
         (moved, _to(xp, device, visible), _to(xp, device, history), device_rng),
     ):
         update = MomentumUpdate(p)
-        _, error = cd_gradients(p, v, h, 2, r, out=update.statistics, scale=0.01)
+        _, error = p.cd_statistics(
+            v,
+            h,
+            None,
+            2,
+            r,
+            out=update.statistics,
+            scale=0.01,
+            workspace=p.new_workspace(20),
+        )
         update.apply(0.5, 0.01, 0.001)
         update.apply(0.5, 0.01, 0.001)  # with momentum
         results.append((p.flat, float(error)))
@@ -201,7 +223,7 @@ def test_training_step_matches_numpy_given_the_same_random_stream():
 def test_gibbs_sampling_matches_numpy_given_the_same_random_stream():
     xp, device = _array_api_for_tests("array_api_strict", "CPU_DEVICE", "float64")
     rng = np.random.default_rng(0)
-    params = CRBMParameters.initialize(4, 6, 1, 1, "gaussian", np.float64, rng)
+    params = CRBMLayer(4, 6, 1, 1, "gaussian", np.float64).initialize(rng)
     moved = params.__sklearn_array_api_convert__(lambda a: _to(xp, device, a))
     start = rng.standard_normal((8, 4))
     history = rng.standard_normal((8, 4))
@@ -212,10 +234,7 @@ def test_gibbs_sampling_matches_numpy_given_the_same_random_stream():
         (params, start, history, numpy_rng),
         (moved, _to(xp, device, start), _to(xp, device, history), device_rng),
     ):
-        visible_bias, hidden_bias = dynamic_biases(p, h)
-        frames.append(
-            gibbs_frames(p, s, visible_bias, hidden_bias, 5, r, hidden_noise=0.3)
-        )
+        frames.append(gibbs_frames(p.frame_rbms(h), s, 5, r, hidden_noise=0.3))
     np.testing.assert_allclose(_numpy(frames[1]), frames[0], rtol=1e-12)
 
 
@@ -321,12 +340,7 @@ def test_baseline_imputers_fill_on_the_input_device_as_on_numpy(
     test_ids = np.repeat([0, 1], [40, 25])
     X_missing[40, :] = np.nan  # a second sequence that starts wholly missing
     train = X[ids < 3]
-    # the nearest-neighbour imputer ignores sequences in fit
-    sequences = (
-        {}
-        if isinstance(imputer, NearestNeighborImputer)
-        else {"sequence_ids": ids[ids < 3]}
-    )
+    sequences = {"sequence_ids": ids[ids < 3]}
     with sklearn.config_context(array_api_dispatch=False):
         reference = clone(imputer).fit(train, **sequences)
         expected = reference.transform(X_missing, sequence_ids=test_ids)
@@ -453,12 +467,10 @@ def test_particle_resampling_is_numpy_s_given_the_same_draws(
     frames, observed = X[:n_sequences], X[:n_sequences] > 0
     results = []
     for estimator, to in ((model, np.asarray), (moved, partial(_to, xp, device))):
-        layers = estimator._layer_parameters()
-        history = History.from_frames(layers, to(past))
-        sequences = np.arange(n_sequences) if to is np.asarray else slice(None)
+        history = History.from_frames(estimator._layers(), to(past))
         chains = _ancestors(
             history,
-            sequences,
+            None,
             to(frames),
             to(observed),
             n_particles,
@@ -466,7 +478,7 @@ def test_particle_resampling_is_numpy_s_given_the_same_draws(
             if to is not np.asarray
             else np.random.default_rng(7),
         )
-        history.reorder(chains, sequences)
+        history.reorder(chains)
         results.append((_numpy(chains), _numpy(history.windows[0])))
     (chains, windows), (chains_xp, windows_xp) = results
     assert (chains != np.arange(8)[:, None]).any()  # some pasts were copied
@@ -490,8 +502,12 @@ def test_crbm_imputer_trains_a_stack_on_the_input_device(
     filled = _numpy(filled)
     assert not np.isnan(filled).any()
     np.testing.assert_array_equal(filled[~missing], X_missing[~missing])
-    with pytest.raises(TypeError, match="move_estimator_to"):
+    # as the baseline imputers: scikit-learn's error under dispatch, ours without
+    with pytest.raises(ValueError, match="same namespace.*move_estimator_to"):
         imputer.transform(X_missing)
+    with sklearn.config_context(array_api_dispatch=False):
+        with pytest.raises(TypeError, match="was fitted on.*move_estimator_to"):
+            imputer.transform(X_missing)
 
 
 @pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
@@ -605,3 +621,112 @@ def test_imputer_refuses_a_frozen_model_of_another_namespace_clearly(
     X_missing[5:9, 1] = np.nan
     filled = imputer.fit(X, sequence_ids=ids).transform(X_missing, sequence_ids=ids)
     assert np.isfinite(filled).all()
+
+
+# ------------------------------------------------------- the default sizes
+# ConditionalRBM() has 200 hidden units and CRBMImputer() 20 particles per
+# draw: training minibatches, generation of many sequences and fill-in then
+# draw 4,096 or more hidden states at once, where the sampler tests float64
+# activations in float32 (issue 30: a crash on float64 data that 6 or 30
+# hidden units never reach).  Both dtypes, on a strict namespace and on
+# PyTorch; a few epochs of short sequences.
+DEFAULT_SIZE_COMBINATIONS = [
+    (namespace, device_name, dtype_name)
+    for namespace, device_name in (("array_api_strict", "CPU_DEVICE"), ("torch", "cpu"))
+    if _available(namespace, device_name)
+    for dtype_name in ("float32", "float64")
+]
+
+
+def _default_model(estimator):
+    """``ConditionalRBM()`` or ``StackedCRBM()`` at their default sizes, 2 epochs."""
+    model_class = ConditionalRBM if estimator == "crbm" else StackedCRBM
+    return model_class(n_iter=2, random_state=0)
+
+
+def _check_outputs(outputs, shapes, reference):
+    for name, output in outputs.items():
+        _same_place(output, reference)
+        assert tuple(output.shape) == shapes[name], name
+        assert np.isfinite(_numpy(output)).all(), name
+
+
+@pytest.mark.parametrize(
+    "namespace, device_name, dtype_name", DEFAULT_SIZE_COMBINATIONS
+)
+@pytest.mark.parametrize("estimator", ["crbm", "stack"])
+def test_every_path_runs_at_the_default_size(
+    namespace, device_name, dtype_name, estimator, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    X_xp = _to(xp, device, X)
+    model = _default_model(estimator)
+    sizes = [200] if estimator == "crbm" else [200, 200]
+    assert list(np.atleast_1d(model.n_components)) == sizes  # the defaults
+    model.fit(X_xp, sequence_ids=ids)
+    model.partial_fit(X_xp, sequence_ids=ids)
+    n_frames, n_features = X.shape
+    outputs = {
+        "transform": model.transform(X_xp, sequence_ids=ids),
+        "predict_next": model.predict_next(X_xp, sequence_ids=ids),
+        "score_samples": model.score_samples(X_xp, sequence_ids=ids),
+        "sample one": model.sample(4, random_state=0),
+        # 30 sequences: 6,000 hidden states per Gibbs step
+        "sample many": model.sample(
+            4, n_sequences=30, hidden_noise=1.0, random_state=0
+        ),
+        "sample history": model.sample(
+            4, history=X_xp[: model.history_length, ...], random_state=0
+        ),
+    }
+    shapes = {
+        "transform": (n_frames, sizes[-1]),
+        "predict_next": (n_frames, n_features),
+        "score_samples": (n_frames,),
+        "sample one": (4, n_features),
+        "sample many": (120, n_features),
+        "sample history": (4, n_features),
+    }
+    _check_outputs(outputs, shapes, X_xp)
+    # the deterministic outputs are those of the same parameters on numpy
+    on_numpy = move_estimator_to(model, np, None)
+    rtol = 1e-4 if dtype_name == "float32" else 1e-10
+    with sklearn.config_context(array_api_dispatch=False):
+        for method in ("transform", "predict_next"):
+            np.testing.assert_allclose(
+                _numpy(outputs[method]),
+                getattr(on_numpy, method)(X, sequence_ids=ids),
+                rtol=rtol,
+                atol=rtol,
+            )
+
+
+@pytest.mark.parametrize(
+    "namespace, device_name, dtype_name", DEFAULT_SIZE_COMBINATIONS
+)
+@pytest.mark.parametrize("estimator", ["crbm", "stack"])
+def test_crbm_imputer_fills_sequences_of_different_lengths_at_the_default_size(
+    namespace, device_name, dtype_name, estimator, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids, X_missing = _imputer_data(dtype_name)
+    # two short test sequences of different lengths, the second starting
+    # missing: 20 particles of 2 sequences draw 8,000 hidden states at once
+    X_missing = np.concatenate([X_missing[8:20], X_missing[:7]])
+    X_missing[12, :] = np.nan
+    test_ids = np.repeat([0, 1], [12, 7])
+    missing = np.isnan(X_missing)
+    imputer = CRBMImputer(_default_model(estimator), n_gibbs=3, random_state=0)
+    assert imputer.n_particles == 20 and imputer.n_draws == 1  # the defaults
+    imputer.fit(_to(xp, device, X), sequence_ids=ids)
+    X_xp = _to(xp, device, X_missing)
+    outputs = {
+        "transform": imputer.transform(X_xp, sequence_ids=test_ids),
+        "sample": imputer.sample(X_xp, 2, sequence_ids=test_ids),
+    }
+    _check_outputs(
+        outputs, {"transform": X_missing.shape, "sample": (2, *X_missing.shape)}, X_xp
+    )
+    for filled in (_numpy(outputs["transform"]), *_numpy(outputs["sample"])):
+        np.testing.assert_array_equal(filled[~missing], X_missing[~missing])

@@ -52,7 +52,7 @@ def ridge(features, targets):
 def no_training(monkeypatch):
     """Epochs that count but change nothing: fit leaves the start as it is."""
 
-    def count(self, X, frames, n_epochs, n_averaged=0):
+    def count(self, X, frames, n_epochs, *other_arguments, **options):
         self.n_iter_ += n_epochs
 
     monkeypatch.setattr(ConditionalRBM, "_train", count)
@@ -140,7 +140,7 @@ def test_reproducible_and_different_from_the_random_start(data):
     first = ConditionalRBM(4, init="autoregressive", **params).fit(X, sequence_ids=ids)
     again = ConditionalRBM(4, init="autoregressive", **params).fit(X, sequence_ids=ids)
     random = ConditionalRBM(4, **params).fit(X, sequence_ids=ids)
-    assert_array_equal(first._parameters.flat, again._parameters.flat)
+    assert_array_equal(first._layer.flat, again._layer.flat)
     assert not np.allclose(first.autoregressive_, random.autoregressive_, atol=0.05)
 
 

@@ -14,7 +14,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.utils._param_validation import InvalidParameterError
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_math import CRBMParameters, ParameterAverage
+from sklearn_crbm._crbm_layer import CRBMLayer
+from sklearn_crbm._parameters import ParameterAverage
 from sklearn_crbm.datasets import make_oscillations
 
 GROUPS = (
@@ -144,7 +145,7 @@ def test_bad_average_fraction_is_rejected(data, bad):
 
 def test_the_running_mean_is_the_mean():
     rng = np.random.default_rng(0)
-    params = CRBMParameters(3, 4, 2, 2, "gaussian", np.float64)
+    params = CRBMLayer(3, 4, 2, 2, "gaussian", np.float64)
     samples = rng.normal(size=(7, params.flat.size))
     average = ParameterAverage()
     for sample in samples:

@@ -16,13 +16,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.special import expit
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_math import (
-    CDWorkspace,
-    CRBMParameters,
-    cd_gradients,
-    dynamic_biases,
-    shift_centred,
-)
+from sklearn_crbm._crbm_layer import CRBMLayer, shift_centred
 from sklearn_crbm.datasets import load_cmu35, make_oscillations
 from sklearn_crbm.preprocessing import make_motion_preprocessor
 
@@ -32,7 +26,7 @@ VARIANCES = ["unit", "fixed", "learned"]
 
 def tiny_params(variance, hidden_order=ORDER, seed=0):
     rng = np.random.default_rng(seed)
-    params = CRBMParameters(
+    params = CRBMLayer(
         N_FEATURES,
         N_COMPONENTS,
         ORDER,
@@ -56,6 +50,27 @@ def std_of(params):
     return np.sqrt(params.visible_variance)
 
 
+def centred_layer(params):
+    """``params`` moved to centred coordinates, as a layer that trains in them."""
+    layer = shift_centred(params.copy(), 1)
+    layer.centered = True
+    return layer
+
+
+def cd_statistics(params, visible, history, cd_steps, rng, *, scale):
+    """The layer's CD statistics of one minibatch, in new buffers."""
+    return params.cd_statistics(
+        visible,
+        history,
+        None,
+        cd_steps,
+        rng,
+        out=params.zeros_like(),
+        scale=scale,
+        workspace=params.new_workspace(len(visible)),
+    )
+
+
 @pytest.mark.parametrize("hidden_order", [ORDER, ORDER + 1])
 @pytest.mark.parametrize("variance", VARIANCES)
 def test_centred_coordinates_are_the_same_model(variance, hidden_order):
@@ -65,8 +80,8 @@ def test_centred_coordinates_are_the_same_model(variance, hidden_order):
     visible = rng.normal(size=(6, N_FEATURES))
     history = rng.normal(size=(6, hidden_order * N_FEATURES))
     s = std_of(params)
-    c_hat, b_hat = dynamic_biases(params, history)
-    c_centred, b_centred = dynamic_biases(centred, history)
+    c_hat, b_hat = params.dynamic_biases(history)
+    c_centred, b_centred = centred.dynamic_biases(history)
     assert_allclose(c_centred, c_hat, rtol=1e-12)  # the visible side is untouched
     standard_input = b_hat + (visible / s) @ params.weights.T
     centred_input = b_centred + ((visible - c_hat) / s) @ centred.weights.T
@@ -118,20 +133,18 @@ def test_centred_statistics_are_the_chain_rule_of_the_standard_ones(
     visible = rng.normal(size=(n, N_FEATURES))
     history = rng.normal(size=(n, hidden_order * N_FEATURES))
 
-    def statistics(model, centered):
-        return cd_gradients(
+    def statistics(model):
+        return cd_statistics(
             model,
             visible.copy(),
             history,
             cd_steps,
             np.random.default_rng(3),  # the same draws: the same hidden states
             scale=0.1,
-            workspace=CDWorkspace(model, n),
-            centered=centered,
         )
 
-    standard, error = statistics(params, False)
-    centred, centred_error = statistics(shift_centred(params.copy(), 1), True)
+    standard, error = statistics(params)
+    centred, centred_error = statistics(centred_layer(params))
     assert centred_error == pytest.approx(error, rel=1e-12)
     for name, value in chain_rule(params, standard).items():
         assert_allclose(getattr(centred, name), value, rtol=1e-9, atol=1e-12)
@@ -140,21 +153,14 @@ def test_centred_statistics_are_the_chain_rule_of_the_standard_ones(
 def test_one_centred_update_against_the_equations():
     """CD-1 of the centred energy, written out (fixed variances)."""
     params = tiny_params("fixed")
-    centred = shift_centred(params.copy(), 1)
+    centred = centred_layer(params)
     rng = np.random.default_rng(4)
     n = 5
     visible = rng.normal(size=(n, N_FEATURES))
     history = rng.normal(size=(n, ORDER * N_FEATURES))
     scale = 0.1
-    gradients, _ = cd_gradients(
-        centred,
-        visible.copy(),
-        history,
-        1,
-        np.random.default_rng(7),
-        scale=scale,
-        workspace=CDWorkspace(centred, n),
-        centered=True,
+    gradients, _ = cd_statistics(
+        centred, visible.copy(), history, 1, np.random.default_rng(7), scale=scale
     )
     draws = np.random.default_rng(7)
     W, s = centred.weights, std_of(centred)

@@ -12,6 +12,7 @@ compares against sums over the 2^H hidden configurations.
 
 import copy
 import itertools
+import re
 import warnings
 
 import numpy as np
@@ -23,15 +24,10 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
 from sklearn_crbm import ConditionalRBM, TrainingDivergedError
-from sklearn_crbm._crbm_math import (
-    cd_gradients,
-    hidden_probabilities,
-    standard_normal,
-    uniform,
-)
+from sklearn_crbm._crbm_layer import CRBMFrames
 from sklearn_crbm.datasets import load_cmu35, make_oscillations
 from sklearn_crbm.model_selection import make_prediction_scorer
-from sklearn_crbm.utils._random import rng_from
+from sklearn_crbm.utils._random import rng_from, standard_normal, uniform
 from sklearn_crbm.utils._sequences import balanced_batches, frame_history
 
 
@@ -331,11 +327,24 @@ def test_momentum_starts_after_delay():
 
 def test_cd_k_runs_k_reconstructions():
     model = random_model(order=1)
-    params = model._parameters
+    layer = model._layer
     X, _ = make_oscillations(n_sequences=1, n_frames=30, n_features=3, random_state=0)
     history = frame_history(X, np.arange(1, 30), 1)
-    g1, e1 = cd_gradients(params, X[1:], history, 1, np.random.default_rng(0))
-    g5, e5 = cd_gradients(params, X[1:], history, 5, np.random.default_rng(0))
+
+    def cd_statistics(cd_steps):
+        return layer.cd_statistics(
+            X[1:],
+            history,
+            None,
+            cd_steps,
+            np.random.default_rng(0),
+            out=layer.zeros_like(),
+            scale=1,
+            workspace=layer.new_workspace(29),
+        )
+
+    g1, e1 = cd_statistics(1)
+    g5, e5 = cd_statistics(5)
     assert not np.allclose(g1.weights, g5.weights)
     assert e5 > e1  # later reconstructions wander further from the data
 
@@ -540,10 +549,13 @@ def test_binary_visibles():
     ).fit(X)
     samples = model.sample(5, n_sequences=2)
     assert np.all((samples >= 0) & (samples <= 1))
-    params = model._parameters
-    H = hidden_probabilities(
-        params, X[1:], params.hidden_bias + X[:-1] @ model.past_to_hidden_[0].T
+    layer = model._layer
+    hidden_bias = layer.hidden_bias + X[:-1] @ model.past_to_hidden_[0].T
+    visible_bias = np.zeros((len(X) - 1, layer.n_features))  # unused by p(h | v)
+    rbms = CRBMFrames(
+        visible_bias, hidden_bias, layer.visible_std, layer.binary, layer.weights
     )
+    H = rbms.hidden_probabilities(X[1:])
     assert_allclose(model.transform(X)[1:], H, rtol=1e-12)
     with pytest.raises(ValueError, match=r"binary.*\[0, 1\]"):
         ConditionalRBM(5, visible_type="binary").fit(X * 3)
@@ -553,9 +565,20 @@ def test_verbose_reports_progress(capsys):
     X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     ConditionalRBM(4, n_iter=4, verbose=2, random_state=0).fit(X, sequence_ids=ids)
     lines = capsys.readouterr().out.strip().splitlines()
-    assert len(lines) == 2
-    assert lines[0].startswith("[ConditionalRBM] Iteration 2, reconstruction error = ")
-    assert "time = " in lines[1]
+    number = r"(\d+\.\d{4})"
+    pattern = (
+        rf"\[ConditionalRBM\] epoch (\d+): one-step error {number} \(previous "
+        rf"frame: {number}\), reconstruction error {number}, time \d+\.\ds"
+    )
+    matches = [re.fullmatch(pattern, line) for line in lines]
+    assert len(lines) == 2 and all(matches), lines
+    assert [int(match[1]) for match in matches] == [2, 4]
+    # repeating the previous frame: the RMS error of X[t - 1] for X[t] over
+    # every trainable frame (those after the first order=3 of each sequence)
+    frames = [t for t in range(3, len(X)) if ids[t - 3] == ids[t]]
+    previous_frame = np.sqrt(np.mean(np.square(X[frames] - X[np.subtract(frames, 1)])))
+    for match in matches:
+        assert float(match[3]) == pytest.approx(previous_frame, abs=1e-4)
 
 
 def test_divergence_raises_naming_the_learning_rate():

@@ -10,8 +10,9 @@ commit wrote; running it now writes the current code's::
     PYTHONPATH=$PWD python tests/test_fingerprints.py
 
 A refactor that keeps the math must keep these numbers: every value of a
-float64 array to ``rtol=1e-12`` (in practice bit for bit), of a float32 array
-to float32 rounding; the sums then agree to that tolerance times the sum of
+float64 model's arrays to ``rtol=1e-12`` (in practice bit for bit), of a
+float32 model's to float32 rounding (its BLAS kernels round differently on
+other processors); the sums then agree to that tolerance times the sum of
 absolute values, and a change of any single value beyond it, or of the order
 of the values, moves the weighted sum.  Only a deliberate change of the math
 or of a random stream may rewrite the file, and its commit must say which
@@ -214,7 +215,10 @@ def test_unchanged(results, key):
     expected = _pinned()[key]
     got = fingerprint(results[key])
     assert (got["dtype"], got["shape"]) == (expected["dtype"], expected["shape"])
-    rtol = 1e-12 if expected["dtype"] == "float64" else 1e-5
+    # float32 models' results to float32 rounding, whatever dtype holds them
+    # (a float32 model's fill of float64 data, its float score)
+    single = expected["dtype"] == "float32" or ".float32" in key
+    rtol = 1e-5 if single else 1e-12
     # each value within rtol of its own: each sum within rtol of the absolute sum
     bound = rtol * expected["sums"][1]
     assert np.all(np.abs(np.subtract(got["sums"], expected["sums"])) <= bound)

@@ -15,9 +15,8 @@ from numpy.testing import assert_allclose
 from scipy.special import logsumexp
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_math import CRBMParameters
+from sklearn_crbm._crbm_layer import CRBMFrames
 from sklearn_crbm._likelihood import (
-    FrameRBMs,
     annealing_schedule,
     exact_is_cheaper,
     log_partition_ais,
@@ -34,10 +33,19 @@ def random_model(
     scale=0.5,
     seed=0,
 ):
-    """A ConditionalRBM with random parameters set by hand (no training)."""
+    """A ConditionalRBM with random parameters set by hand (no training).
+
+    With ``variance`` the model learns its variances (a unit-variance model
+    keeps ``s = 1`` whatever is assigned to ``visible_variance_``).
+    """
     rng = np.random.default_rng(seed)
     model = ConditionalRBM(
-        n_components, order=order, visible_type=visible_type, n_iter=1, random_state=0
+        n_components,
+        order=order,
+        visible_type=visible_type,
+        visible_variance="unit" if variance is None else "learned",
+        n_iter=1,
+        random_state=0,
     )
     model.fit(rng.random((order + 5, n_features)))
     model.components_ = scale * rng.standard_normal((n_components, n_features))
@@ -191,11 +199,10 @@ def test_reverse_and_forward_estimates_bracket_the_exact_value(
 def test_ais_is_unbiased_for_the_partition_function():
     """Many chains: log of the mean weight converges on the exact log Z."""
     rng = np.random.default_rng(0)
-    params = CRBMParameters(4, 8, 0, 0, "gaussian", np.float64)
-    params.weights[...] = rng.standard_normal((8, 4))
-    rbms = FrameRBMs(
-        params, rng.standard_normal((3, 4)), rng.standard_normal((3, 8)), [0.5, 1, 1, 2]
-    )
+    weights = rng.standard_normal((8, 4))
+    visible_bias, hidden_bias = rng.standard_normal((3, 4)), rng.standard_normal((3, 8))
+    std = np.array([0.5, 1, 1, 2])
+    rbms = CRBMFrames(visible_bias, hidden_bias, std, False, weights)
     log_z, error = log_partition_ais(rbms, 200, 2000, np.random.default_rng(1))
     assert_allclose(log_z, log_partition_exact(rbms), atol=max(0.01, 4 * error.max()))
 

@@ -9,12 +9,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 
 from sklearn_crbm import ConditionalRBM, StackedCRBM
 from sklearn_crbm._base import FittedParameter
-from sklearn_crbm._crbm_math import (
-    CRBMParameters,
-    dynamic_biases,
-    gibbs_frames,
-    hidden_probabilities,
-)
+from sklearn_crbm._crbm_layer import CRBMLayer
+from sklearn_crbm._gibbs import gibbs_frames
 from sklearn_crbm._online import (
     TOP_LAYER,
     WHOLE_STACK,
@@ -33,9 +29,9 @@ def _layers(orders=((2, 2), (1, 3)), seed=0):
     layers, n_visible = [], 6
     for k, (order, hidden_order) in enumerate(orders):
         kind = "gaussian" if k == 0 else "binary"
-        params = CRBMParameters.initialize(
-            n_visible, 5 - k, order, hidden_order, kind, np.float64, rng
-        )
+        params = CRBMLayer(
+            n_visible, 5 - k, order, hidden_order, kind, np.float64
+        ).initialize(rng)
         params.flat[...] = 0.5 * rng.standard_normal(params.flat.shape)
         params.dynamic *= params.dynamic_mask()
         layers.append(params)
@@ -53,8 +49,7 @@ def test_history_from_frames_passes_up_with_edge_padding():
     # past with the first frame repeated where the past runs out
     padded = [X[max(t - 1, 0)] for t in range(4)], [X[max(t - 2, 0)] for t in range(4)]
     history_rows = np.hstack([np.array(padded[0]), np.array(padded[1])])
-    _, hidden_bias = dynamic_biases(layers[0], history_rows)
-    hidden = hidden_probabilities(layers[0], X[:4], hidden_bias)
+    hidden = layers[0].frame_rbms(history_rows).hidden_probabilities(X[:4])
     # layer 0 has two lags: frames 2 and 3 have a full past; the window of
     # layer 1 (three lags) repeats the oldest of them
     assert_allclose(top[0, 0], hidden[[3, 2, 2]], rtol=1e-12)
@@ -74,7 +69,8 @@ def test_one_layer_schemes_are_one_gibbs_run():
             scheme=scheme,
             start_jitter=0.01,
         )
-        runs[scheme] = np.stack([frames for _, _, _, frames in run])
+        runs[scheme] = np.stack([frames for _, frames in run])
+    assert runs[TOP_LAYER].shape == (4, 1, 2, 6)  # steps, chains, sequences
     assert_array_equal(runs[TOP_LAYER], runs[WHOLE_STACK])
 
     # the same chains written out: jitter, then gibbs_frames, frame by frame
@@ -82,9 +78,8 @@ def test_one_layer_schemes_are_one_gibbs_run():
     past = list(seed[0].transpose(1, 0, 2))
     for step in range(4):
         history = np.hstack([past[-1], past[-2]])
-        visible_bias, hidden_bias = dynamic_biases(layer, history)
         start = past[-1] + 0.01 * rng.standard_normal(past[-1].shape)
-        frame = gibbs_frames(layer, start, visible_bias, hidden_bias, 3, rng)
+        frame = gibbs_frames(layer.frame_rbms(history), start, 3, rng)
         assert_allclose(runs[TOP_LAYER][step, 0], frame, rtol=1e-12)
         past.append(frame)
 
@@ -100,7 +95,7 @@ def test_fill_in_clamps_observed_channels_on_a_stack():
         sequences=check_sequence_ids(IDS, len(X)),
     )
     seen = np.zeros(len(X), dtype=bool)
-    for step, sequences, drawn, frames in run_online(
+    for step, frames in run_online(
         layers,
         np.random.default_rng(0),
         observed=observed,
@@ -109,16 +104,19 @@ def test_fill_in_clamps_observed_channels_on_a_stack():
         n_gibbs=2,
         scheme=WHOLE_STACK,
     ):
-        rows = 30 * sequences[drawn] + step
-        assert missing[rows].any(axis=1).all()
+        # every sequence at every step (all three are 30 frames long)
+        rows = 30 * np.arange(3) + step
         seen[rows] = True
-        assert frames.shape == (4, len(drawn), 6)
+        assert frames.shape == (4, 3, 6)
         assert np.isfinite(frames).all()
+        # observed entries come back as they are, whole frames included
         assert_array_equal(
             frames[:, ~missing[rows]],
             np.broadcast_to(X[rows][~missing[rows]], (4, (~missing[rows]).sum())),
         )
-    assert_array_equal(seen, missing.any(axis=1))
+        # missing entries are drawn, not left at their placeholder 0
+        assert np.all(frames[:, missing[rows]] != 0)
+    assert seen.all()
 
 
 def test_a_stack_clamps_only_with_the_whole_stack_scheme():
@@ -166,9 +164,9 @@ def test_fitted_attributes_view_the_packed_parameters():
     for name in names:
         if name == "visible_variance_":  # exp of the packed log-variances
             continue
-        assert np.shares_memory(getattr(model, name), model._parameters.flat)
+        assert np.shares_memory(getattr(model, name), model._layer.flat)
         loaded = pickle.loads(pickle.dumps(model))
-        assert np.shares_memory(getattr(loaded, name), loaded._parameters.flat)
+        assert np.shares_memory(getattr(loaded, name), loaded._layer.flat)
         assert_array_equal(getattr(loaded, name), getattr(model, name))
     before = model.transform(X)
     model.components_ = 2 * model.components_  # assignment writes the model

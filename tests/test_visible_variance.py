@@ -18,17 +18,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.special import expit, logsumexp
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_math import (
-    CDWorkspace,
-    CRBMParameters,
-    HiddenSampler,
-    cd_gradients,
-    dynamic_biases,
-    hidden_probabilities,
-    sample_visible_states,
-    visible_means,
-)
-from sklearn_crbm._likelihood import FrameRBMs
+from sklearn_crbm._crbm_layer import CRBMFrames, CRBMLayer
+from sklearn_crbm._gibbs import HiddenSampler, sample_visible_states
 from sklearn_crbm.datasets import make_oscillations
 
 N_FEATURES, N_COMPONENTS, ORDER = 2, 3, 1
@@ -37,7 +28,7 @@ HIDDEN = np.array(list(itertools.product([0, 1], repeat=N_COMPONENTS)), dtype=fl
 
 def tiny_params(seed=0, zero_weights=False):
     rng = np.random.default_rng(seed)
-    params = CRBMParameters(
+    params = CRBMLayer(
         N_FEATURES,
         N_COMPONENTS,
         ORDER,
@@ -63,8 +54,29 @@ def energy(v, h, c, b, params):
 def frame(params, seed=1):
     rng = np.random.default_rng(seed)
     history = rng.normal(size=(1, ORDER * N_FEATURES))
-    c, b = dynamic_biases(params, history)
+    c, b = params.dynamic_biases(history)
     return rng.normal(size=N_FEATURES), c[0], b[0]
+
+
+def frame_rbms(params, visible_bias, hidden_bias):
+    """The RBMs of frames with the dynamic biases given (one row each)."""
+    return CRBMFrames(
+        visible_bias, hidden_bias, params.visible_std, params.binary, params.weights
+    )
+
+
+def cd_statistics(params, visible, history, cd_steps, rng, *, scale=1.0):
+    """The layer's CD statistics of one minibatch, in new buffers."""
+    return params.cd_statistics(
+        visible,
+        history,
+        None,
+        cd_steps,
+        rng,
+        out=params.zeros_like(),
+        scale=scale,
+        workspace=params.new_workspace(len(visible)),
+    )
 
 
 def test_visible_variance_is_a_view_of_the_log_variance():
@@ -73,7 +85,7 @@ def test_visible_variance_is_a_view_of_the_log_variance():
     assert_allclose(params.visible_std, np.exp(params.log_visible_variance / 2))
     params.visible_variance = np.array([0.25, 4.0])
     assert_allclose(params.log_visible_variance, np.log([0.25, 4.0]))
-    unit = CRBMParameters(2, 3, 1, 1, "gaussian", np.float64)
+    unit = CRBMLayer(2, 3, 1, 1, "gaussian", np.float64)
     assert unit.visible_std is None
     assert_array_equal(unit.visible_variance, np.ones(2))
 
@@ -84,7 +96,7 @@ def test_hidden_conditional_by_enumeration():
     log_joint = np.array([-energy(v, h, c, b, params) for h in HIDDEN])
     posterior = np.exp(log_joint - logsumexp(log_joint))
     expected = posterior @ HIDDEN  # p(h_j = 1 | v)
-    got = hidden_probabilities(params, v[None], b[None])[0]
+    got = frame_rbms(params, c[None], b[None]).hidden_probabilities(v[None])[0]
     assert_allclose(got, expected, rtol=1e-12)
     s = np.sqrt(params.visible_variance)
     assert_allclose(got, expit(b + params.weights @ (v / s)), rtol=1e-12)
@@ -96,7 +108,7 @@ def test_visible_conditional_is_the_gaussian_of_the_energy():
     rng = np.random.default_rng(2)
     variance = params.visible_variance
     for h in HIDDEN:
-        mean = visible_means(params, h[None], c[None])[0]
+        mean = frame_rbms(params, c[None], b[None]).visible_mean(h[None])[0]
         assert_allclose(
             mean, c + np.sqrt(variance) * (params.weights.T @ h), rtol=1e-12
         )
@@ -116,25 +128,24 @@ def test_samplers_follow_the_conditionals():
     # (numpy's float64 uniforms: fewer than _MIN_BIT_DRAWS at once)
     n = 1000
     visible = np.repeat(v[None], n, axis=0)
-    hidden_bias = np.repeat(b[None], n, axis=0)
+    means = np.repeat(c[None], n, axis=0)
+    rbms = frame_rbms(params, means, np.repeat(b[None], n, axis=0))
     states = np.empty((n, N_COMPONENTS))
-    HiddenSampler(params, hidden_bias)(
+    HiddenSampler(rbms)(
         visible, np.random.default_rng(3), states, np.empty_like(states)
     )
     uniforms = np.random.default_rng(3).random((n, N_COMPONENTS))
-    probabilities = hidden_probabilities(params, visible, hidden_bias)
+    probabilities = rbms.hidden_probabilities(visible)
     assert_array_equal(states, uniforms < probabilities)
     # visible draws: mean + s * standard normal
-    means = np.repeat(c[None], n, axis=0)
-    draws = sample_visible_states(params, means, np.random.default_rng(4))
+    draws = sample_visible_states(rbms, means, np.random.default_rng(4))
     noise = np.random.default_rng(4).standard_normal((n, N_FEATURES))
     assert_allclose(draws, means + np.sqrt(params.visible_variance) * noise)
 
 
 def free_energy(params, visible, visible_bias, hidden_bias):
     """F(v | history) as the package computes it for its likelihood."""
-    rbms = FrameRBMs(params, visible_bias, hidden_bias, params.visible_std)
-    return -rbms.negative_free_energy(visible)
+    return -frame_rbms(params, visible_bias, hidden_bias).negative_free_energy(visible)
 
 
 def test_free_energy_by_enumeration():
@@ -184,9 +195,9 @@ def test_exact_log_likelihood_of_a_fitted_model_by_enumeration():
         random_state=0,
     ).fit(X, sequence_ids=ids)
     assert not np.allclose(model.visible_variance_, 1.0)
-    params = model._parameters
+    params = model._layer
     history = X[:-1]
-    c, b = dynamic_biases(params, history)
+    c, b = params.dynamic_biases(history)
     negative_free = -free_energy(params, X[1:], c, b)
     # score_samples: log p(x_t | past), frame 0 edge padded (one sequence here)
     scores = model.score_samples(X[ids == 0])
@@ -206,8 +217,8 @@ def test_without_hidden_units_the_variance_statistic_is_the_exact_gradient():
     rng = np.random.default_rng(5)
     visible = rng.normal(size=(7, N_FEATURES))
     history = rng.normal(size=(7, ORDER * N_FEATURES))
-    gradients, _ = cd_gradients(params, visible, history, 1, rng)
-    c, _ = dynamic_biases(params, history)
+    gradients, _ = cd_statistics(params, visible, history, 1, rng)
+    c, _ = params.dynamic_biases(history)
     variance = params.visible_variance
     exact = ((visible - c) ** 2 / (2 * variance) - 0.5).sum(axis=0)
     assert_allclose(gradients.log_visible_variance, exact, rtol=1e-12)
@@ -221,14 +232,8 @@ def test_one_update_against_the_equations(cd_steps):
     visible = rng.normal(size=(n, N_FEATURES))
     history = rng.normal(size=(n, ORDER * N_FEATURES))
     scale = 0.1
-    gradients, squared_error = cd_gradients(
-        params,
-        visible.copy(),
-        history,
-        cd_steps,
-        np.random.default_rng(7),
-        scale=scale,
-        workspace=CDWorkspace(params, n),
+    gradients, squared_error = cd_statistics(
+        params, visible.copy(), history, cd_steps, np.random.default_rng(7), scale=scale
     )
 
     # written out: the sampler draws one uniform per hidden unit and step
@@ -294,7 +299,7 @@ def test_variances_are_computed_from_the_packed_log_variances():
     X, ids = make_oscillations(n_sequences=3, n_frames=30, random_state=4)
     model = ConditionalRBM(8, order=2, visible_variance="learned", n_iter=3)
     model.fit(X, sequence_ids=ids)
-    packed = model._parameters
+    packed = model._layer
     assert np.shares_memory(packed.log_visible_variance, packed.flat)
     assert_allclose(model.visible_variance_, np.exp(packed.log_visible_variance))
     loaded = pickle.loads(pickle.dumps(model))
@@ -317,3 +322,11 @@ def test_binary_visibles_cannot_learn_variances():
         ConditionalRBM(
             4, visible_type="binary", visible_variance="learned", n_iter=2
         ).fit(X)
+
+
+def test_setting_the_variances_of_a_unit_variance_model_is_an_error():
+    X, ids = make_oscillations(n_sequences=3, n_frames=30, random_state=3)
+    model = ConditionalRBM(8, order=2, n_iter=2).fit(X, sequence_ids=ids)
+    with pytest.raises(ValueError, match="unit variance"):
+        model.visible_variance_ = np.full(X.shape[1], 0.5)
+    assert_array_equal(model.visible_variance_, 1.0)

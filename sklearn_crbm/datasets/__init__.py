@@ -20,7 +20,7 @@ from ._channels import bone_columns
 from ._fetch import fetch_cmu35, fetch_mit_walk
 from ._folders import read_amc_folder, read_bvh_folder
 from ._frame_rate import resample_frames
-from ._generators import make_oscillations, make_walker
+from ._generators import make_oscillations, make_styled_oscillations, make_walker
 from ._skeleton import Skeleton
 
 __all__ = [
@@ -33,6 +33,7 @@ __all__ = [
     "load_cmu35",
     "load_mit_walk",
     "make_oscillations",
+    "make_styled_oscillations",
     "make_walker",
     "read_amc",
     "read_amc_folder",

@@ -79,6 +79,54 @@ def make_oscillations(
     return X, sequence_ids
 
 
+def make_styled_oscillations(
+    n_sequences=8, n_frames=60, n_features=6, *, switching=False, random_state=None
+):
+    """Oscillations in two styles: a tiny stand-in for a labelled corpus.
+
+    The frames of :func:`make_oscillations`, whose first column tells the
+    style: about +1 in style ``"high"``, about -1 in style ``"low"`` (plus
+    noise of standard deviation 0.1).  Odd sequences are ``"high"``, even
+    ones ``"low"``; with ``switching`` the style is drawn anew for every
+    frame instead, so that only a frame's label, not its past, tells its
+    style.
+
+    Parameters
+    ----------
+    n_sequences : int, default=8
+        Number of sequences.
+    n_frames : int, default=60
+        Frames per sequence.
+    n_features : int, default=6
+        Number of columns.
+    switching : bool, default=False
+        Draw every frame's style at random (equal odds).
+    random_state : int, RandomState instance or None, default=None
+        Seed for the oscillations, the styles and the noise.
+
+    Returns
+    -------
+    X : ndarray of shape (n_sequences * n_frames, n_features)
+    sequence_ids : ndarray of shape (n_sequences * n_frames,)
+    styles : ndarray of str of shape (n_sequences * n_frames,)
+        ``"high"`` or ``"low"``, frame by frame.
+
+    Examples
+    --------
+    >>> from sklearn_crbm.datasets import make_styled_oscillations
+    >>> X, ids, styles = make_styled_oscillations(n_sequences=2, random_state=0)
+    >>> styles[[0, 60]]
+    array(['low', 'high'], dtype='<U4')
+    >>> bool(X[60:, 0].mean() > 0.5)
+    True
+    """
+    rng = check_random_state(random_state)
+    X, ids = make_oscillations(n_sequences, n_frames, n_features, random_state=rng)
+    high = rng.random_sample(len(ids)) < 0.5 if switching else ids % 2 == 1
+    X[:, 0] = np.where(high, 1.0, -1.0) + 0.1 * rng.standard_normal(len(ids))
+    return X, ids, np.where(high, "high", "low")
+
+
 # (name, parent, direction, length, dof) of the walker, ASF style: y up,
 # +z forward, +x to the subject's left, lengths in CMU ASF units.
 _WALKER_BONES = [

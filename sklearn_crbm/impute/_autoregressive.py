@@ -3,32 +3,21 @@
 from numbers import Integral, Real
 
 import numpy as np
-from sklearn.base import (
-    BaseEstimator,
-    OneToOneFeatureMixin,
-    TransformerMixin,
-    _fit_context,
-)
-from sklearn.utils._array_api import check_same_namespace
-from sklearn.utils._missing import is_scalar_nan
-from sklearn.utils._param_validation import Interval, MissingValues, StrOptions
-from sklearn.utils.validation import check_is_fitted
+from sklearn.base import _fit_context
+from sklearn.utils._param_validation import Interval, StrOptions
 
 from ..utils._array_api import array_ops
 from ..utils._autoregression import ridge_autoregression, solve_positive
 from ..utils._fitting import unfitted_on_error
-from ..utils._persistence import VersionedPickleMixin
 from ..utils._sequences import check_sequence_ids
-from ._base import check_imputer_input, check_same_place, complete_runs, to_numpy
+from ._base import BaseMotionImputer, to_numpy
 
 # Added to the diagonal of every covariance: keeps it invertible when a
 # channel is (nearly) a linear function of the others or of the past.
 _REG_COVAR = 1e-6
 
 
-class AutoregressiveImputer(
-    VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
-):
+class AutoregressiveImputer(BaseMotionImputer):
     """Fill missing channels on-line with a linear-Gaussian autoregressive model.
 
     The model is ``x_t = intercept + sum_q A_q x_{t-q} + e_t`` with ``e_t ~
@@ -112,14 +101,13 @@ class AutoregressiveImputer(
     """
 
     _parameter_constraints: dict = {
+        **BaseMotionImputer._parameter_constraints,
         "order": [Interval(Integral, 0, None, closed="left")],
         "alpha": [Interval(Real, 0, None, closed="left")],
         "covariance_type": [StrOptions({"full", "diag"})],
-        "missing_values": [MissingValues()],
     }
 
-    __metadata_request__fit = {"sequence_ids": True}
-    __metadata_request__transform = {"sequence_ids": True}
+    _fitted_attribute = "coef_"
 
     def __init__(
         self, *, order=3, alpha=1.0, covariance_type="full", missing_values=np.nan
@@ -150,10 +138,8 @@ class AutoregressiveImputer(
             The fitted imputer.
         """
         with unfitted_on_error(self):
-            X, mask = check_imputer_input(self, X, reset=True)
+            X, run_ids, _ = self._complete_frames(X, sequence_ids)
             ops = array_ops(X)
-            rows, run_ids = complete_runs(to_numpy(mask), sequence_ids)
-            X = ops.take(X, rows, axis=0)
             sequences = check_sequence_ids(run_ids, X.shape[0])
             frames = sequences.valid_frames(self.order)
             if len(frames) < 2:
@@ -199,15 +185,11 @@ class AutoregressiveImputer(
         X_filled : ndarray of shape (n_frames, n_features)
             ``X`` with no missing value left.
         """
-        check_is_fitted(self)
-        check_same_namespace(X, self, attribute="coef_", method="transform")
-        X, mask = check_imputer_input(self, X, reset=False)
-        check_same_place(self.coef_, X, "AutoregressiveImputer was fitted on")
+        X, mask, sequences = self._check_transform_input(X, sequence_ids)
         ops = array_ops(X)
         mask = to_numpy(mask)
         if not mask.any():
             return X
-        sequences = check_sequence_ids(sequence_ids, X.shape[0])
         n_steps, n_features = int(sequences.lengths.max()), X.shape[1]
         # step-major: frame t of every sequence in one slice; a sequence's
         # last frame pads it, never written and never read as a past
@@ -251,12 +233,6 @@ class AutoregressiveImputer(
         if isinstance(self.coef_, np.ndarray):
             return self.coef_.transpose(0, 2, 1)
         return array_ops(self.coef_).permute_dims(self.coef_, (0, 2, 1))
-
-    def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
-        tags.array_api_support = True
-        return tags
 
 
 def _fill_conditional(frames, mask, mean, covariance, gains, marginal):

@@ -1,18 +1,100 @@
-"""What both imputers share: input checks and the missing-value mask."""
+"""What the imputers share: a base class with their input checks and tags."""
 
 import numpy as np
+from sklearn.base import BaseEstimator, OneToOneFeatureMixin, TransformerMixin
 from sklearn.utils._array_api import (
-    _convert_to_numpy,
     _is_numpy_namespace,
+    check_same_namespace,
     get_namespace,
     get_namespace_and_device,
 )
 from sklearn.utils._mask import _get_mask
 from sklearn.utils._missing import is_scalar_nan
-from sklearn.utils.validation import FLOAT_DTYPES, validate_data
+from sklearn.utils._param_validation import MissingValues
+from sklearn.utils.validation import FLOAT_DTYPES, check_is_fitted, validate_data
 
-from ..utils._array_api import array_ops
+from ..utils._array_api import array_ops, to_numpy
+from ..utils._persistence import VersionedPickleMixin
 from ..utils._sequences import check_sequence_ids
+
+__all__ = ["BaseMotionImputer"]
+
+
+class BaseMotionImputer(
+    VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
+):
+    """Base class of the imputers of motion sequences.
+
+    They follow :mod:`sklearn.impute`: ``fit`` learns from complete frames,
+    ``transform`` fills every entry equal to ``missing_values`` and returns
+    the observed values unchanged, and both take ``sequence_ids`` (requested
+    through metadata routing, so a Pipeline passes it on).  Subclasses call
+    :meth:`_complete_frames` at the start of ``fit`` and
+    :meth:`_check_transform_input` at the start of ``transform``, and name
+    in ``_fitted_attribute`` a fitted array whose namespace and device the
+    input must share.
+    """
+
+    _parameter_constraints: dict = {"missing_values": [MissingValues()]}
+
+    # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
+    # search passes ``sequence_ids`` to these methods without being asked.
+    __metadata_request__fit = {"sequence_ids": True}
+    __metadata_request__transform = {"sequence_ids": True}
+
+    _fitted_attribute: str
+
+    def _complete_frames(self, X, sequence_ids):
+        """Validate ``fit``'s input; its complete frames, their run ids and rows.
+
+        A frame with a missing value is left out and splits its sequence in
+        two (:func:`complete_runs`).
+        """
+        X, mask = check_imputer_input(self, X, reset=True)
+        rows, run_ids = complete_runs(to_numpy(mask), sequence_ids)
+        return array_ops(X).take(X, rows, axis=0), run_ids, rows
+
+    def _check_transform_input(self, X, sequence_ids):
+        """Validate ``transform``'s input: ``X`` (a float copy), its mask, sequences."""
+        check_is_fitted(self)
+        check_same_namespace(
+            X, self, attribute=self._fitted_attribute, method="transform"
+        )
+        X, mask = check_imputer_input(self, X, reset=False)
+        check_same_place(
+            getattr(self, self._fitted_attribute),
+            X,
+            f"{type(self).__name__} was fitted on",
+        )
+        return X, mask, check_sequence_ids(sequence_ids, X.shape[0])
+
+    def fit_transform(self, X, y=None, *, sequence_ids=None):
+        """Fit on ``X``, then fill its missing values.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            Training sequences; the imputer learns from their complete
+            frames, then their missing values are filled.
+        y : None
+            Ignored.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+
+        Returns
+        -------
+        X_filled : ndarray of shape (n_frames, n_features)
+            ``X`` with no missing value left, as a new array.
+        """
+        return self.fit(X, sequence_ids=sequence_ids).transform(
+            X, sequence_ids=sequence_ids
+        )
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
+        tags.array_api_support = True
+        return tags
 
 
 def check_imputer_input(imputer, X, *, reset):
@@ -73,11 +155,6 @@ def complete_runs(mask, sequence_ids):
     run_ids = np.cumsum(new_run) - 1
     rows = np.flatnonzero(complete)
     return rows, run_ids[rows]
-
-
-def to_numpy(array):
-    """``array`` as a numpy array (a copy off the host)."""
-    return _convert_to_numpy(array, get_namespace_and_device(array)[0])
 
 
 def check_same_place(fitted, X, what):

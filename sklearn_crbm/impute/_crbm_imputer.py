@@ -3,35 +3,22 @@
 from numbers import Integral, Real
 
 import numpy as np
-from sklearn.base import (
-    BaseEstimator,
-    OneToOneFeatureMixin,
-    TransformerMixin,
-    _fit_context,
-    clone,
-)
+from sklearn.base import _fit_context, clone
 from sklearn.frozen import FrozenEstimator
-from sklearn.utils import check_random_state
-from sklearn.utils._missing import is_scalar_nan
-from sklearn.utils._param_validation import (
-    HasMethods,
-    Interval,
-    MissingValues,
-    StrOptions,
-)
+from sklearn.utils import check_random_state, get_tags
+from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
 from sklearn.utils.validation import check_is_fitted
 
 from .._base import check_count
 from .._crbm import ConditionalRBM
-from .._online import WHOLE_STACK, Observed, run_online
+from .._online import WHOLE_STACK, Observed, collect_fills, run_online
 from ..utils._array_api import array_ops, array_random, copy_array
 from ..utils._fitting import unfitted_on_error
 from ..utils._parallel import BLOCK_SEQUENCES, map_sequence_blocks
-from ..utils._persistence import VersionedPickleMixin
 from ..utils._random import rng_from
 from ..utils._sequences import Sequences, check_sequence_ids
 from ..utils._threads import chain_rows, limit_blas_threads
-from ._base import check_imputer_input, check_same_place, complete_runs
+from ._base import BaseMotionImputer, check_same_place
 from ._base import to_numpy as _to_numpy
 
 
@@ -47,9 +34,7 @@ def _default_model(random_state):
     return ConditionalRBM(random_state=seed)
 
 
-class CRBMImputer(
-    VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
-):
+class CRBMImputer(BaseMotionImputer):
     """Fill missing channels on-line with a conditional RBM (paper §4.4).
 
     ``fit`` trains a clone of ``estimator`` on complete sequences.
@@ -318,6 +303,7 @@ class CRBMImputer(
     """
 
     _parameter_constraints: dict = {
+        **BaseMotionImputer._parameter_constraints,
         "estimator": [HasMethods(["fit", "transform"]), None],
         "n_gibbs": [Interval(Integral, 0, None, closed="left")],
         "n_draws": [Interval(Integral, 1, None, closed="left")],
@@ -325,16 +311,14 @@ class CRBMImputer(
         "offset_shrinkage": [Interval(Real, 0, None, closed="left"), None],
         "observation_gain": [Interval(Real, 0, None, closed="left")],
         "observation_weighting": [StrOptions({"residual", "uniform"})],
-        "missing_values": [MissingValues()],
         "random_state": ["random_state"],
         "n_jobs": [None, Integral],
         "verbose": ["verbose"],
     }
 
-    # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
-    # search passes ``sequence_ids`` to these methods without being asked.
-    __metadata_request__fit = {"sequence_ids": True}
-    __metadata_request__transform = {"sequence_ids": True}
+    _fitted_attribute = "_packed_parameters"
+
+    __metadata_request__transform = {"sequence_ids": True, "style": True}
 
     def __init__(
         self,
@@ -373,8 +357,10 @@ class CRBMImputer(
             Training sequences, stacked, each contiguous and in time order.
             The model learns from complete frames only: a frame with a
             missing value is left out and splits its sequence in two.
-        y : None
-            Ignored.
+        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
+            The style of every frame, for a model of styles
+            (:class:`~sklearn_crbm.FactoredCRBM`), which needs it; ignored
+            by a model without styles.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
 
@@ -384,22 +370,23 @@ class CRBMImputer(
             The fitted imputer.
         """
         with unfitted_on_error(self):
-            X, mask = check_imputer_input(self, X, reset=True)
+            X, run_ids, rows = self._complete_frames(X, sequence_ids)
             ops = array_ops(X)
-            rows, run_ids = complete_runs(_to_numpy(mask), sequence_ids)
-            X = ops.take(X, rows, axis=0)
             estimator = self.estimator
             if estimator is None:
                 estimator = _default_model(self.random_state)
+            styles = _complete_styles(estimator, y, rows)
             if isinstance(estimator, FrozenEstimator):
                 self.estimator_ = _check_frozen(estimator.estimator, X)
             else:
-                self.estimator_ = self._train(clone(estimator), X, run_ids)
+                self.estimator_ = self._train(clone(estimator), X, run_ids, styles)
             self.mean_ = ops.mean(X, axis=0)
-            self.residual_variance_ = _residual_variance(self.estimator_, X, run_ids)
+            self.residual_variance_ = _residual_variance(
+                self.estimator_, X, run_ids, styles
+            )
         return self
 
-    def _train(self, estimator, X, sequence_ids):
+    def _train(self, estimator, X, sequence_ids, styles):
         if self.verbose:
             if estimator.get_params().get("verbose", 1) == 0:
                 estimator.set_params(verbose=self.verbose)
@@ -407,32 +394,10 @@ class CRBMImputer(
                 f"[{type(self).__name__}] training {estimator!r} on {len(X)} "
                 f"complete frames in {len(np.unique(sequence_ids))} sequences"
             )
-        return estimator.fit(X, sequence_ids=sequence_ids)
-
-    def fit_transform(self, X, y=None, *, sequence_ids=None):
-        """Fit on ``X``, then fill its missing values on-line.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            Training sequences; the model learns from their complete frames
-            (see :meth:`fit`), then their missing values are filled.
-        y : None
-            Ignored.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-
-        Returns
-        -------
-        X_filled : ndarray of shape (n_frames, n_features)
-            ``X`` with no missing value left, as a new array.
-        """
-        return self.fit(X, sequence_ids=sequence_ids).transform(
-            X, sequence_ids=sequence_ids
-        )
+        return estimator.fit(X, styles, sequence_ids=sequence_ids)
 
     @limit_blas_threads(chain_rows)
-    def transform(self, X, *, sequence_ids=None):
+    def transform(self, X, *, sequence_ids=None, style=None):
         """Fill every missing value of ``X`` on-line.
 
         Parameters
@@ -442,6 +407,13 @@ class CRBMImputer(
             time order.  Observed values come back unchanged.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        style : label or array-like of shape (n_frames,) or (n_frames, \
+n_classes), default=None
+            A model of styles only: the style of every frame.  None infers
+            it on-line: the particles of each draw carry one style each
+            (``n_particles`` at least the number of styles covers them all),
+            and resampling by how well each explains the observed channels
+            keeps the particles of the styles that do.
 
         Returns
         -------
@@ -449,10 +421,14 @@ class CRBMImputer(
             ``X`` with each missing value replaced by the average of
             ``n_draws`` on-line fills; no missing value is left.
         """
-        return self._impute(X, sequence_ids, self.n_draws, self.random_state, True)
+        return self._impute(
+            X, sequence_ids, style, self.n_draws, self.random_state, True
+        )
 
     @limit_blas_threads(chain_rows)
-    def sample(self, X, n_samples=1, *, sequence_ids=None, random_state=None):
+    def sample(
+        self, X, n_samples=1, *, sequence_ids=None, style=None, random_state=None
+    ):
         """Draw independent on-line fills of ``X`` (multiple imputation).
 
         Each fill is one run of the procedure of :meth:`transform` with a
@@ -469,6 +445,9 @@ class CRBMImputer(
             Number of fills.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        style : label or array-like, default=None
+            A model of styles only: every frame's style (see
+            :meth:`transform`).
         random_state : int, RandomState instance or None, default=None
             Seeds the sampling; ``None`` uses the imputer's ``random_state``.
 
@@ -479,25 +458,28 @@ class CRBMImputer(
         """
         n_samples = check_count(n_samples, "n_samples", minimum=1)
         random_state = self.random_state if random_state is None else random_state
-        return self._impute(X, sequence_ids, n_samples, random_state, False)
+        return self._impute(X, sequence_ids, style, n_samples, random_state, False)
 
-    def _impute(self, X, sequence_ids, n_draws, random_state, average):
-        check_is_fitted(self)
-        X, mask = check_imputer_input(self, X, reset=False)
-        _check_same_place(self.estimator_, X, "CRBMImputer was fitted with")
+    @property
+    def _packed_parameters(self):
+        """The model's parameter buffer: its namespace and device."""
+        return self.estimator_._packed_parameters
+
+    def _impute(self, X, sequence_ids, style, n_draws, random_state, average):
+        X, mask, sequences = self._check_transform_input(X, sequence_ids)
         ops = array_ops(X)
-        sequences = check_sequence_ids(sequence_ids, X.shape[0])
+        context = self.estimator_._online_context(X, style)
         if not bool(ops.any(mask)):
             return (
                 X if average else copy_array(ops.broadcast_to(X, (n_draws, *X.shape)))
             )
         rng = rng_from(random_state)
-        draws = self._fill_blocks(X, mask, sequences, n_draws, rng)
+        draws = self._fill_blocks(X, mask, sequences, context, n_draws, rng)
         if average:
             draws = ops.mean(draws, axis=0)
         return ops.where(mask, ops.astype(draws, X.dtype), X)
 
-    def _fill_blocks(self, X, mask, sequences, n_draws, rng):
+    def _fill_blocks(self, X, mask, sequences, context, n_draws, rng):
         """:meth:`_fill` on blocks of whole sequences, in parallel with ``n_jobs``.
 
         The blocks and their random streams depend on the data only
@@ -512,8 +494,16 @@ class CRBMImputer(
                 lengths=sequences.lengths[block],
                 ids=sequences.ids[block],
             )
+            frame_context, hypotheses = context
+            if frame_context is not None:
+                frame_context = frame_context[lo:hi, ...]
             return self._fill(
-                X[lo:hi, ...], mask[lo:hi, ...], block_sequences, n_draws, block_rng
+                X[lo:hi, ...],
+                mask[lo:hi, ...],
+                block_sequences,
+                (frame_context, hypotheses),
+                n_draws,
+                block_rng,
             )
 
         ops = array_ops(X)
@@ -527,43 +517,52 @@ class CRBMImputer(
         )
         return ops.concatenate(blocks, axis=1)
 
-    def _fill(self, X, mask, sequences, n_draws, rng):
+    def _fill(self, X, mask, sequences, context, n_draws, rng):
         """``n_draws`` on-line fills, all sequences and draws advancing together.
 
         Every draw runs ``n_particles`` chains (:func:`~sklearn_crbm._online.
         run_online` with the observed channels clamped); a draw's fill of a
-        frame is the mean of its particles'.  Returns an array of shape
+        frame is the mean of its particles'.  ``context`` is the model's
+        ``(frame_context, hypotheses)``.  Returns an array of shape
         ``(n_draws, n_frames, n_features)`` in the model's dtype.
         """
-        layers = self.estimator_._layer_parameters()
+        layers = self.estimator_._layers()
         dtype, ops = layers[0].dtype, layers[0].ops
         X = ops.astype(X, dtype)
+        frame_context, hypotheses = context
+        n_chains = n_draws * self.n_particles
+        chain_context = None
+        if hypotheses is not None:  # particle i of every draw: hypothesis i mod K
+            picks = np.arange(n_chains) % self.n_particles % hypotheses.shape[0]
+            chain_context = ops.take(hypotheses, picks, axis=0)[:, None, :]
+            chain_context = ops.broadcast_to(
+                chain_context, (n_chains, sequences.n_sequences, hypotheses.shape[1])
+            )
         # a sequence's first frame starts its missing channels at the mean
         observed = Observed(
             X=ops.where(mask, ops.astype(self.mean_, dtype), X),
             missing=mask,
             sequences=sequences,
+            context=frame_context,
         )
         run = run_online(
             layers,
             array_random(rng, X),
             observed=observed,
-            n_chains=n_draws * self.n_particles,
+            chain_context=chain_context,
+            n_chains=n_chains,
             n_particles=self.n_particles,
             n_gibbs=self.n_gibbs,
             scheme=WHOLE_STACK,
             offset_shrinkage=self.offset_shrinkage,
             observation_gain=self._observation_gains(ops, X),
         )
-        if ops is not np:
-            return self._gather_fills(run, sequences, n_draws, X.shape)
-        out = np.broadcast_to(X, (n_draws, *X.shape)).copy()
-        for step, active, drawn, frames in run:
-            if not len(drawn):
-                continue
-            fills = frames.reshape(n_draws, self.n_particles, len(drawn), -1)
-            out[:, sequences.starts[active[drawn]] + step] = fills.mean(axis=1)
-        return out
+
+        def mean_of_particles(frames):
+            frames = ops.reshape(frames, (n_draws, self.n_particles, *frames.shape[1:]))
+            return ops.mean(frames, axis=1)
+
+        return collect_fills(run, sequences, mean_of_particles)
 
     def _observation_gains(self, ops, X):
         """``observation_gain`` per channel (see ``observation_weighting``).
@@ -581,57 +580,38 @@ class CRBMImputer(
         )
         return ops.asarray(np.maximum(1 + (gain - 1) * weights, 0), dtype=X.dtype)
 
-    def _gather_fills(self, run, sequences, n_draws, shape):
-        """:meth:`_fill`'s result from :func:`run_online` off numpy.
-
-        There every step holds every sequence's frame (see
-        :func:`~sklearn_crbm._online.run_online`): the steps are stacked and
-        the frames of the data gathered from them in one go, on the device.
-        """
-        n_sequences = len(sequences.starts)
-        fills = []
-        for _, _, _, frames in run:
-            ops = array_ops(frames)
-            frames = ops.reshape(frames, (n_draws, self.n_particles, n_sequences, -1))
-            fills.append(ops.mean(frames, axis=1))
-        # row ``starts[s] + t`` of the data is step t of sequence s
-        index = np.zeros(shape[0], dtype=np.int64)
-        for s, (start, length) in enumerate(
-            zip(sequences.starts, sequences.lengths, strict=True)
-        ):
-            index[start : start + length] = np.arange(length) * n_sequences + s
-        steps = ops.reshape(ops.xp.stack(fills, axis=1), (n_draws, -1, shape[1]))
-        return ops.take(steps, index, axis=1)
-
-    def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
-        return tags
-
 
 # The most a channel's weight in observation_weighting="residual" may be.
 MAX_CHANNEL_WEIGHT = 3.0
 
 
-def _residual_variance(model, X, sequence_ids):
+def _complete_styles(estimator, y, rows):
+    """The styles of the complete frames, for a model of styles (else None)."""
+    if not get_tags(estimator).target_tags.required:
+        return None
+    if y is None:
+        raise ValueError(
+            f"CRBMImputer around {type(estimator).__name__} needs y in fit: the "
+            "style of every training frame."
+        )
+    return np.asarray(y)[rows]
+
+
+def _residual_variance(model, X, sequence_ids, styles):
     """Each channel's variance of ``X - model.predict_next(X)``.
 
     Over the frames with a full past in their sequence (all frames if none
-    has one).
+    has one), given the frames' ``styles`` for a model of styles.
     """
     ops = array_ops(X)
-    residuals = X - model.predict_next(X, sequence_ids=sequence_ids)
     sequences = check_sequence_ids(sequence_ids, X.shape[0])
+    context = model._online_context(X, styles)[0]
+    residuals = X - model._predict_frames(X, sequences, context=context)
     rows = sequences.valid_frames(model.history_length)
     if len(rows):
         residuals = ops.take(residuals, rows, axis=0)
     centred = residuals - ops.mean(residuals, axis=0)
     return ops.mean(centred * centred, axis=0)
-
-
-def _check_same_place(model, X, what):
-    """Refuse ``X`` in another namespace or on another device than ``model``."""
-    check_same_place(model._packed_parameters, X, what)
 
 
 def _check_frozen(model, X):
@@ -648,5 +628,7 @@ def _check_frozen(model, X):
             f"{model.n_features_in_} features but X has {n_features}: fit the "
             "imputer on data with the model's features (same preprocessing)."
         )
-    _check_same_place(model, X, f"The frozen {type(model).__name__} holds")
+    check_same_place(
+        model._packed_parameters, X, f"The frozen {type(model).__name__} holds"
+    )
     return model

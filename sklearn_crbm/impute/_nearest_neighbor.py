@@ -1,30 +1,17 @@
 """The paper's baseline: fill each frame from its nearest training frame."""
 
 import numpy as np
-from sklearn.base import (
-    BaseEstimator,
-    OneToOneFeatureMixin,
-    TransformerMixin,
-    _fit_context,
-)
-from sklearn.utils._array_api import check_same_namespace
-from sklearn.utils._missing import is_scalar_nan
-from sklearn.utils._param_validation import MissingValues
-from sklearn.utils.validation import check_is_fitted
+from sklearn.base import _fit_context
 
 from ..utils._array_api import array_ops
 from ..utils._fitting import unfitted_on_error
-from ..utils._persistence import VersionedPickleMixin
-from ..utils._sequences import check_sequence_ids
-from ._base import check_imputer_input, check_same_place, complete_runs, to_numpy
+from ._base import BaseMotionImputer, to_numpy
 
 # Distances computed at once: bounds memory to about 32 MB of float64.
 _MAX_DISTANCES = 1 << 22
 
 
-class NearestNeighborImputer(
-    VersionedPickleMixin, OneToOneFeatureMixin, TransformerMixin, BaseEstimator
-):
+class NearestNeighborImputer(BaseMotionImputer):
     """Fill missing channels from the nearest training frame (paper §4.4 baseline).
 
     For each frame, the Euclidean distance over that frame's observed
@@ -89,16 +76,13 @@ class NearestNeighborImputer(
            [ 2. ,  2.1, 20. ]])
     """
 
-    _parameter_constraints: dict = {"missing_values": [MissingValues()]}
-
-    # Wholly missing frames repeat the previous frame of their own sequence.
-    __metadata_request__transform = {"sequence_ids": True}
+    _fitted_attribute = "_fit_X"
 
     def __init__(self, *, missing_values=np.nan):
         self.missing_values = missing_values
 
     @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y=None):
+    def fit(self, X, y=None, *, sequence_ids=None):
         """Keep the complete training frames.
 
         Parameters
@@ -107,6 +91,9 @@ class NearestNeighborImputer(
             Training frames; those with a missing value are left out.
         y : None
             Ignored.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+            Checked, then unused: frames are matched independently.
 
         Returns
         -------
@@ -114,9 +101,8 @@ class NearestNeighborImputer(
             The fitted imputer.
         """
         with unfitted_on_error(self):
-            X, mask = check_imputer_input(self, X, reset=True)
+            X, _, _ = self._complete_frames(X, sequence_ids)
             ops = array_ops(X)
-            X = ops.take(X, complete_runs(to_numpy(mask), None)[0], axis=0)
             self._fit_X = X
             self._squared_norms = ops.einsum("ij,ij->i", X, X)
             self.mean_ = ops.mean(X, axis=0)
@@ -138,13 +124,9 @@ class NearestNeighborImputer(
         X_filled : ndarray of shape (n_frames, n_features)
             ``X`` with no missing value left.
         """
-        check_is_fitted(self)
-        check_same_namespace(X, self, attribute="_fit_X", method="transform")
-        X, mask = check_imputer_input(self, X, reset=False)
-        check_same_place(self._fit_X, X, "NearestNeighborImputer was fitted on")
+        X, mask, sequences = self._check_transform_input(X, sequence_ids)
         ops = array_ops(X)
         mask = to_numpy(mask)
-        sequences = check_sequence_ids(sequence_ids, X.shape[0])
         empty = mask.all(axis=1)
         partial = np.flatnonzero(mask.any(axis=1) & ~empty)
         if len(partial):
@@ -180,12 +162,6 @@ class NearestNeighborImputer(
             distances += train_norms
             nearest.append(to_numpy(ops.argmin(distances, axis=1)))
         return np.concatenate(nearest)
-
-    def __sklearn_tags__(self):
-        tags = super().__sklearn_tags__()
-        tags.input_tags.allow_nan = is_scalar_nan(self.missing_values)
-        tags.array_api_support = True
-        return tags
 
 
 def _split(rows, groups):

@@ -23,6 +23,7 @@ from numbers import Real
 
 import numpy as np
 from sklearn.externals import array_api_compat
+from sklearn.utils._array_api import _convert_to_numpy
 
 __all__ = [
     "ArrayOps",
@@ -33,6 +34,7 @@ __all__ = [
     "is_numpy",
     "same_memory",
     "to_device_batches",
+    "to_numpy",
 ]
 
 
@@ -142,6 +144,9 @@ class ArrayOps:
 
     def concatenate(self, arrays, axis=0):
         return self.xp.concat(tuple(arrays), axis=axis)
+
+    def stack(self, arrays, axis=0):
+        return self.xp.stack(tuple(arrays), axis=axis)
 
     def repeat(self, x, repeats, axis=None):
         return self.xp.repeat(x, repeats, axis=axis)
@@ -307,6 +312,13 @@ def array_random(rng, like):
     if is_numpy(like) or isinstance(rng, ArrayRandom):
         return rng
     return ArrayRandom(int(rng.integers(2**63 - 1)), array_ops(like))
+
+
+def to_numpy(array):
+    """``array`` as a numpy array (itself for numpy, a copy off the host)."""
+    if isinstance(array, np.ndarray):
+        return array
+    return np.asarray(_convert_to_numpy(array, array_api_compat.array_namespace(array)))
 
 
 def copy_array(x):

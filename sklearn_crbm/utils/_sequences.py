@@ -15,6 +15,7 @@ import numpy as np
 from ._array_api import array_ops
 
 __all__ = [
+    "CHUNK_FRAMES",
     "Sequences",
     "balanced_batches",
     "check_sequence_ids",
@@ -23,6 +24,11 @@ __all__ = [
     "shuffled_batches",
     "validation_split",
 ]
+
+
+# Frames whose histories are gathered at once by the loops over whole data
+# sets (transform, score and friends): bounds their memory on long data.
+CHUNK_FRAMES = 4096
 
 
 @dataclass(frozen=True)

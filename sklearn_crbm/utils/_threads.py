@@ -18,8 +18,8 @@ import numpy as np
 from threadpoolctl import ThreadpoolController
 
 from .._config import get_config
-from .._crbm_math import CHUNK_FRAMES
 from ._parallel import BLOCK_SEQUENCES, SAMPLE_BLOCK
+from ._sequences import CHUNK_FRAMES
 
 __all__ = [
     "MIN_WORK_PER_THREAD",

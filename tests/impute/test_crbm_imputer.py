@@ -280,9 +280,9 @@ def test_verbose_reports_training(capsys):
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("[CRBMImputer] training ConditionalRBM(")
     assert lines[0].endswith("on 40 complete frames in 2 sequences")
-    assert [line.split(",")[0] for line in lines[1:]] == [
-        "[ConditionalRBM] Iteration 2",
-        "[ConditionalRBM] Iteration 4",
+    assert [line.split(":")[0] for line in lines[1:]] == [
+        "[ConditionalRBM] epoch 2",
+        "[ConditionalRBM] epoch 4",
     ]
     assert model.verbose == 0  # the clone was told, not the user's model
     CRBMImputer(model).fit(X, sequence_ids=ids)
@@ -344,10 +344,15 @@ def test_stacked_estimator(test_data, n_particles):
 
 
 def test_observed_log_likelihood_hand_computed():
-    from sklearn_crbm._crbm_math import CRBMParameters, observed_log_likelihood
+    from sklearn_crbm._crbm_layer import CRBMLayer
+    from sklearn_crbm._gibbs import observed_log_likelihood
+
+    def frame_rbms(n_features, visible_type, n_frames):
+        layer = CRBMLayer(n_features, 2, 1, 1, visible_type, np.float64)
+        return layer.initialize(rng).frame_rbms(np.zeros((n_frames, n_features)))
 
     rng = np.random.default_rng(0)
-    gaussian = CRBMParameters.initialize(3, 2, 1, 1, "gaussian", np.float64, rng)
+    gaussian = frame_rbms(3, "gaussian", 2)
     prediction = np.array([[0.0, 1.0, 2.0], [1.0, 1.0, 1.0]])
     visible = np.array([[1.0, 1.0, 99.0], [1.0, 3.0, 0.0]])
     observed = np.array([[True, True, False], [True, True, True]])
@@ -355,7 +360,7 @@ def test_observed_log_likelihood_hand_computed():
         observed_log_likelihood(gaussian, prediction, visible, observed),
         [-0.5 * 1.0, -0.5 * (0.0 + 4.0 + 1.0)],
     )
-    binary = CRBMParameters.initialize(2, 2, 1, 1, "binary", np.float64, rng)
+    binary = frame_rbms(2, "binary", 1)
     prediction = np.array([[0.8, 0.25]])
     assert_allclose(
         observed_log_likelihood(
@@ -366,37 +371,21 @@ def test_observed_log_likelihood_hand_computed():
 
 
 def test_stacked_gibbs_with_one_layer_is_gibbs_frames():
-    from sklearn_crbm._crbm_math import (
-        CRBMParameters,
-        dynamic_biases,
-        gibbs_frames,
-        stacked_gibbs_frames,
-    )
+    from sklearn_crbm._crbm_layer import CRBMLayer
+    from sklearn_crbm._gibbs import gibbs_frames, stacked_gibbs_frames
 
     rng = np.random.default_rng(0)
-    params = CRBMParameters.initialize(4, 5, 2, 2, "gaussian", np.float64, rng)
+    params = CRBMLayer(4, 5, 2, 2, "gaussian", np.float64).initialize(rng)
     params.weights *= 50
     history = rng.normal(size=(6, 8))
     start = rng.normal(size=(6, 4))
     observed = rng.random((6, 4)) < 0.5
-    visible_bias, hidden_bias = dynamic_biases(params, history)
+    rbms = params.frame_rbms(history)
     expected = gibbs_frames(
-        params,
-        start,
-        visible_bias,
-        hidden_bias,
-        5,
-        np.random.default_rng(1),
-        observed_mask=observed,
+        rbms, start, 5, np.random.default_rng(1), observed_mask=observed
     )
     got = stacked_gibbs_frames(
-        [params],
-        start,
-        [visible_bias],
-        [hidden_bias],
-        5,
-        np.random.default_rng(1),
-        observed_mask=observed,
+        [rbms], start, 5, np.random.default_rng(1), observed_mask=observed
     )
     assert_array_equal(got, expected)
     assert_array_equal(got[observed], start[observed])

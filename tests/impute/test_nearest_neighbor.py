@@ -2,7 +2,9 @@
 
 import numpy as np
 import pytest
+import sklearn
 from numpy.testing import assert_allclose, assert_array_equal
+from sklearn.pipeline import make_pipeline
 
 from sklearn_crbm.impute import NearestNeighborImputer, _nearest_neighbor
 
@@ -113,3 +115,21 @@ def test_feature_names_out():
     imputer = NearestNeighborImputer().fit(np.eye(3))
     assert_array_equal(imputer.get_feature_names_out(), ["x0", "x1", "x2"])
     assert_array_equal(imputer.get_feature_names_out(["a", "b", "c"]), ["a", "b", "c"])
+
+
+def test_fit_takes_and_checks_sequence_ids_as_the_other_imputers():
+    train, _, X_missing, _ = random_problem(7)
+    ids = np.repeat([0, 1, 2], 100)
+    expected = NearestNeighborImputer().fit(train).transform(X_missing)
+    imputer = NearestNeighborImputer().fit(train, sequence_ids=ids)
+    assert_array_equal(imputer.transform(X_missing), expected)  # unused in fit
+    with pytest.raises(ValueError, match="2 entries but X has 300 frames"):
+        NearestNeighborImputer().fit(train, sequence_ids=ids[:2])
+    with pytest.raises(ValueError, match="occurs in more than one"):
+        NearestNeighborImputer().fit(train, sequence_ids=np.tile([0, 1], 150))
+    # a Pipeline routes the ids to fit and transform, as for CRBMImputer
+    with sklearn.config_context(enable_metadata_routing=True):
+        pipe = make_pipeline(NearestNeighborImputer())
+        pipe.fit(train, sequence_ids=ids)
+        filled = pipe.transform(X_missing, sequence_ids=np.zeros(len(X_missing)))
+    assert_array_equal(filled, expected)

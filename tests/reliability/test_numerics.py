@@ -8,8 +8,8 @@ import pytest
 import sklearn
 
 from sklearn_crbm import TrainingDivergedError
-from sklearn_crbm import _crbm_math as crbm_math
-from sklearn_crbm._likelihood import FrameRBMs
+from sklearn_crbm._crbm_layer import CRBMFrames, CRBMLayer
+from sklearn_crbm._layer import logistic
 from sklearn_crbm.datasets import load_cmu35, make_walker
 from sklearn_crbm.impute import CRBMImputer
 from sklearn_crbm.preprocessing import (
@@ -141,7 +141,7 @@ def test_paper_settings_stay_finite_on_cmu35(dtype, cmu_preprocessed, factories)
 def test_logistic_is_exact_and_silent_for_large_inputs(dtype):
     a = np.array([-1e4, -800.0, -50.0, 0.0, 50.0, 800.0, 1e4], dtype=dtype)
     with np.errstate(all="raise"):
-        p = crbm_math.logistic(a.copy())
+        p = logistic(a.copy())
     assert p.dtype == dtype
     assert np.isfinite(p).all()
     assert p[0] == 0.0 and p[1] == 0.0 and p[-1] == 1.0 and p[-2] == 1.0
@@ -152,8 +152,12 @@ def test_logistic_is_exact_and_silent_for_large_inputs(dtype):
 
 def _params(dtype, n_features=3, n_components=4):
     rng = np.random.default_rng(0)
-    return crbm_math.CRBMParameters.initialize(
-        n_features, n_components, 2, 2, "gaussian", dtype, rng
+    return CRBMLayer(n_features, n_components, 2, 2, "gaussian", dtype).initialize(rng)
+
+
+def _frame_rbms(params, visible_bias, hidden_bias):
+    return CRBMFrames(
+        visible_bias, hidden_bias, params.visible_std, params.binary, params.weights
     )
 
 
@@ -162,8 +166,9 @@ def test_hidden_probabilities_for_huge_activations(dtype):
     params = _params(dtype)
     visible = np.ones((2, 3), dtype=dtype)
     hidden_bias = np.array([[-1e4, 1e4, -3e4, 3e4]] * 2, dtype=dtype)
+    visible_bias = np.zeros((2, 3), dtype=dtype)
     with np.errstate(all="raise"):
-        p = crbm_math.hidden_probabilities(params, visible, hidden_bias)
+        p = _frame_rbms(params, visible_bias, hidden_bias).hidden_probabilities(visible)
     assert p.dtype == dtype
     np.testing.assert_array_equal(p, [[0.0, 1.0, 0.0, 1.0]] * 2)
 
@@ -175,12 +180,14 @@ def test_free_energy_for_huge_activations(dtype):
     visible = np.array([[1.0, 2.0, 3.0]], dtype=dtype)
     visible_bias = np.zeros((1, 3), dtype=dtype)
     hidden_bias = np.array([[-1e4, 1e4, -3e4, 3e4]], dtype=dtype)
-    rbms = FrameRBMs(params, visible_bias, hidden_bias)
-    with np.errstate(**TROUBLE):
-        negative = rbms.negative_free_energy(visible)
-    # 0.5 * |v|^2 - sum softplus: softplus(-a) = 0 and softplus(a) = a for a >> 1
-    np.testing.assert_allclose(-negative, [7.0 - 4e4], rtol=1e-6)
-    assert negative.dtype == np.float64  # the likelihood sums in float64
+    rbms = _frame_rbms(params, visible_bias, hidden_bias)
+    # in the layer's dtype, and in float64 as the likelihood sums
+    for frames, out_dtype in ((rbms, dtype), (rbms.astype(np.float64), np.float64)):
+        with np.errstate(**TROUBLE):
+            negative = frames.negative_free_energy(visible)
+        # 0.5 * |v|^2 - sum softplus: softplus(-a) = 0 and softplus(a) = a for a >> 1
+        np.testing.assert_allclose(-negative, [7.0 - 4e4], rtol=1e-6)
+        assert negative.dtype == out_dtype
 
 
 @pytest.fixture(scope="module")

@@ -81,15 +81,15 @@ def test_set_config_overrides_auto(two_threads):
 def test_estimators_limit_their_loops(two_threads, monkeypatch):
     X, ids = make_oscillations(n_sequences=3, n_frames=40, n_features=4, random_state=0)
     seen = []
-    import sklearn_crbm._crbm as crbm_module
+    from sklearn_crbm._crbm_layer import CRBMLayer
 
-    original = crbm_module.cd_gradients
+    original = CRBMLayer.cd_statistics
 
     def spy(*args, **kwargs):
         seen.append(min(blas_threads()))
         return original(*args, **kwargs)
 
-    monkeypatch.setattr(crbm_module, "cd_gradients", spy)
+    monkeypatch.setattr(CRBMLayer, "cd_statistics", spy)
     with sklearn_crbm.config_context(blas_threads=1):
         model = ConditionalRBM(5, order=2, n_iter=1, random_state=0)
         model.fit(X, sequence_ids=ids)

@@ -1,40 +1,28 @@
-"""The fast paths of ``_crbm_math`` compute the same numbers as the plain formulas.
+"""The CRBM layer's fast paths compute the same numbers as the plain formulas.
 
-Buffers, in-place activations, the velocity accumulation folded into
-``cd_gradients`` and the memory layout of the parameters are optimisations
-only: these tests pin them to the straightforward expressions.
+Buffers, in-place activations, the velocity accumulation folded into the CD
+statistics and the memory layout of the parameters are optimisations only:
+these tests pin them to the straightforward expressions.
 """
 
+import pickle
 import warnings
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
-from scipy import stats
 from scipy.special import expit
 
-from sklearn_crbm._crbm_math import (
-    CDWorkspace,
-    CRBMParameters,
-    HiddenSampler,
-    MomentumUpdate,
-    add_history_noise,
-    add_normal_noise,
-    cd_gradients,
-    dynamic_biases,
-    gibbs_frames,
-    hidden_probabilities,
-    logistic,
-    standard_normal,
-    uniform,
-)
+from sklearn_crbm._crbm_layer import CRBMFrames, CRBMLayer
+from sklearn_crbm._gibbs import HiddenSampler, gibbs_frames
+from sklearn_crbm._layer import logistic
+from sklearn_crbm._parameters import MomentumUpdate
+from sklearn_crbm.utils._random import uniform
 
 
 def make_params(dtype=np.float64, order=2, hidden_order=2, seed=0, scale=0.5):
     rng = np.random.default_rng(seed)
-    params = CRBMParameters.initialize(
-        5, 7, order, hidden_order, "gaussian", dtype, rng
-    )
+    params = CRBMLayer(5, 7, order, hidden_order, "gaussian", dtype).initialize(rng)
     params.flat[...] = scale * rng.standard_normal(params.flat.shape)
     params.dynamic *= params.dynamic_mask()
     return params
@@ -46,6 +34,22 @@ def batch(params, n=30, seed=1):
     visible = rng.standard_normal((n, params.n_features)).astype(dtype)
     history = rng.standard_normal((n, params.n_lags * params.n_features)).astype(dtype)
     return visible, history
+
+
+def frames_of(params, hidden_bias, visible_bias=None):
+    """The frame RBMs of ``params`` with the given dynamic biases."""
+    if visible_bias is None:
+        visible_bias = np.zeros((len(hidden_bias), params.n_features), params.dtype)
+    return CRBMFrames(visible_bias, hidden_bias, None, False, params.weights)
+
+
+def cd(params, visible, history, cd_steps, rng, *, out=None, scale=1.0, workspace=None):
+    """The layer's CD statistics, in new buffers unless given."""
+    out = params.zeros_like() if out is None else out
+    workspace = params.new_workspace(len(visible)) if workspace is None else workspace
+    return params.cd_statistics(
+        visible, history, None, cd_steps, rng, out=out, scale=scale, workspace=workspace
+    )
 
 
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
@@ -62,93 +66,6 @@ def test_logistic_is_expit_without_warnings(dtype):
     assert_array_equal(out, result)
 
 
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-@pytest.mark.parametrize("symmetric", [False, True])
-def test_uniform_draws_are_uniform_reproducible_and_in_range(dtype, symmetric):
-    draws = uniform(np.random.default_rng(0), (400, 250), dtype, symmetric=symmetric)
-    low = -1.0 if symmetric else 0.0
-    assert draws.dtype == dtype and draws.shape == (400, 250)
-    assert draws.min() >= low and draws.max() < 1
-    # 10^5 draws: mean and variance of U(low, 1) to within 5 standard errors
-    width = 1 - low
-    assert abs(draws.mean() - (low + 1) / 2) < 5 * width / np.sqrt(12 * draws.size)
-    assert draws.var() == pytest.approx(width**2 / 12, rel=0.02)
-    counts, _ = np.histogram(draws, bins=10, range=(low, 1))
-    assert counts.min() > 0.95 * draws.size / 10
-    again = uniform(np.random.default_rng(0), (400, 250), dtype, symmetric=symmetric)
-    assert_array_equal(again, draws)
-    out = np.empty((400, 250), dtype)
-    result = uniform(
-        np.random.default_rng(0), (400, 250), dtype, out, symmetric=symmetric
-    )
-    assert result is out
-    assert_array_equal(out, draws)
-
-
-def test_float64_uniform_draws_are_the_generators_own():
-    expected = np.random.default_rng(4).random((3, 5))
-    assert_array_equal(uniform(np.random.default_rng(4), (3, 5), np.float64), expected)
-
-
-def test_float32_uniform_draws_are_the_bit_generators_mantissas():
-    shape = (50, 99)  # an odd number of draws, enough for the bit route
-    size = 50 * 99
-    raw = np.random.default_rng(4).bit_generator.random_raw((size + 1) // 2)
-    expected = (raw.view(np.uint32)[:size] >> 9).astype(np.float64) / 2**23
-    draws = uniform(np.random.default_rng(4), shape, np.float32)
-    assert_array_equal(draws.ravel(), expected.astype(np.float32))
-    small = uniform(np.random.default_rng(4), (3, 5), np.float32)
-    assert_array_equal(small, np.random.default_rng(4).random((3, 5), np.float32))
-
-
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-def test_few_normal_draws_are_the_generators_own(dtype):
-    draws = standard_normal(np.random.default_rng(4), (3, 5), dtype)
-    expected = np.random.default_rng(4).standard_normal((3, 5), dtype)
-    assert draws.dtype == dtype
-    assert_array_equal(draws, expected)
-
-
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-def test_normal_draws_are_box_muller_of_the_uniforms(dtype):
-    shape = (400, 251)  # an odd number of draws, enough for the bit route
-    size, half = 400 * 251, (400 * 251 + 1) // 2
-    u, v = uniform(np.random.default_rng(4), (2, half), np.float32).astype(float)
-    radius = np.sqrt(-2 * np.log1p(-u))
-    expected = np.concatenate(
-        [radius * np.cos(2 * np.pi * v), radius * np.sin(2 * np.pi * v)]
-    )
-    draws = standard_normal(np.random.default_rng(4), shape, dtype)
-    assert draws.dtype == dtype and draws.shape == shape
-    assert_allclose(draws.ravel(), expected[:size], rtol=1e-5, atol=1e-5)
-    # float64 draws are the float32 ones, converted
-    single = standard_normal(np.random.default_rng(4), shape, np.float32)
-    assert_array_equal(draws, single.astype(dtype))
-    # standard normal: 10^5 draws pass Kolmogorov-Smirnov, pairs uncorrelated
-    assert stats.kstest(draws.ravel().astype(float), "norm").pvalue > 1e-3
-    assert abs(draws.mean()) < 5 / np.sqrt(size)
-    assert draws.var() == pytest.approx(1, abs=5 * np.sqrt(2 / size))
-    assert (
-        abs(np.corrcoef(draws.ravel()[: half - 1], draws.ravel()[half:-1])[0, 1]) < 0.02
-    )
-    for out in (np.empty(shape, dtype), np.empty((400, 502), dtype)[:, ::2]):
-        assert standard_normal(np.random.default_rng(4), shape, dtype, out) is out
-        assert_array_equal(out, draws)
-
-
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-@pytest.mark.parametrize("shape", [(3, 5), (100, 93)])
-def test_add_normal_noise_adds_scaled_standard_normals(dtype, shape):
-    base = np.linspace(-1, 1, shape[0] * shape[1]).reshape(shape).astype(dtype)
-    noisy = base.copy()
-    work = np.empty(shape, dtype)
-    assert add_normal_noise(np.random.default_rng(2), noisy, 0.3, work) is noisy
-    draw_dtype = dtype if shape == (3, 5) else np.float32  # >= 4096: float32
-    draws = standard_normal(np.random.default_rng(2), shape, draw_dtype)
-    assert noisy.dtype == dtype
-    assert_allclose(noisy, base + (0.3 * draws).astype(dtype), rtol=1e-6, atol=1e-7)
-
-
 @pytest.mark.parametrize(
     "dtype, n, symmetric",
     [
@@ -161,18 +78,18 @@ def test_add_normal_noise_adds_scaled_standard_normals(dtype, shape):
 def test_hidden_sampler_is_uniform_below_probability(dtype, n, symmetric):
     params = make_params(dtype)
     visible, history = batch(params, n=n)
-    _, hidden_bias = dynamic_biases(params, history)
+    _, hidden_bias = params.dynamic_biases(history)
     shape = hidden_bias.shape
     out, work = np.empty(shape, dtype), np.empty(shape, dtype)
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-        sampler = HiddenSampler(params, hidden_bias)
+        sampler = HiddenSampler(frames_of(params, hidden_bias))
         states = sampler(visible, np.random.default_rng(3), out, work)
     assert states is out and states.dtype == dtype
     test_dtype = np.float32 if symmetric else np.float64
     draws = uniform(np.random.default_rng(3), shape, test_dtype, symmetric=symmetric)
     u = (draws.astype(float) + 1) / 2 if symmetric else draws
-    p = hidden_probabilities(
-        make_params(), visible.astype(float), hidden_bias.astype(float)
+    p = frames_of(make_params(), hidden_bias.astype(float)).hidden_probabilities(
+        visible.astype(float)
     )
     expected = u < p
     # the forms agree with u < p except within rounding of the boundary
@@ -192,7 +109,7 @@ def test_hidden_states_have_their_probabilities_as_frequencies(dtype):
     visible = np.zeros((2000, params.n_features), dtype)
     out, work = np.empty_like(hidden_bias), np.empty_like(hidden_bias)
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-        states = HiddenSampler(params, hidden_bias)(
+        states = HiddenSampler(frames_of(params, hidden_bias))(
             visible, np.random.default_rng(8), out, work
         )
     p = expit(levels)
@@ -205,30 +122,28 @@ def test_hidden_states_have_their_probabilities_as_frequencies(dtype):
 def test_hidden_noise_is_added_to_the_hidden_biases(dtype, n):
     params = make_params(dtype)
     visible, history = batch(params, n=n)
-    _, hidden_bias = dynamic_biases(params, history)
+    _, hidden_bias = params.dynamic_biases(history)
     shape = hidden_bias.shape
     out, work, noise = (np.empty(shape, dtype) for _ in range(3))
-    noisy = HiddenSampler(params, hidden_bias)(
+    noisy = HiddenSampler(frames_of(params, hidden_bias))(
         visible, np.random.default_rng(6), out, work, hidden_noise=1.5, noise=noise
     ).copy()
     rng = np.random.default_rng(6)
     shifted = hidden_bias + 1.5 * rng.standard_normal(shape, dtype=dtype)
-    expected = HiddenSampler(params, shifted)(visible, rng, out, work)
+    expected = HiddenSampler(frames_of(params, shifted))(visible, rng, out, work)
     assert (noisy != expected).mean() < 1e-3
 
 
 @pytest.mark.parametrize("cd_steps", [1, 3])
 @pytest.mark.parametrize("orders", [(2, 2), (1, 3), (3, 0), (0, 0)])
-def test_cd_gradients_scale_into_reused_buffers(cd_steps, orders):
+def test_cd_statistics_scale_into_reused_buffers(cd_steps, orders):
     params = make_params(order=orders[0], hidden_order=orders[1])
     visible, history = batch(params)
-    plain, error = cd_gradients(
-        params, visible, history, cd_steps, np.random.default_rng(0)
-    )
+    plain, error = cd(params, visible, history, cd_steps, np.random.default_rng(0))
     out = params.zeros_like()
     out.flat[...] = np.nan
-    workspace = CDWorkspace(params, 50)  # larger than the batch: reused slices
-    result, error2 = cd_gradients(
+    workspace = params.new_workspace(50)  # larger than the batch: reused slices
+    result, error2 = cd(
         params,
         visible,
         history,
@@ -310,8 +225,6 @@ def test_parameters_are_views_of_one_buffer_in_either_layout():
 
 
 def test_parameters_pickle_as_one_buffer():
-    import pickle
-
     params = make_params().copy("F")
     loaded = pickle.loads(pickle.dumps(params))
     assert_array_equal(loaded.flat, params.flat)
@@ -321,13 +234,11 @@ def test_parameters_pickle_as_one_buffer():
     assert np.shares_memory(loaded.weights, loaded.flat)
 
 
-def test_cd_gradients_do_not_depend_on_memory_layout():
+def test_cd_statistics_do_not_depend_on_memory_layout():
     params = make_params()
     visible, history = batch(params)
-    c_order, _ = cd_gradients(params, visible, history, 1, np.random.default_rng(0))
-    f_order, _ = cd_gradients(
-        params.copy("F"), visible, history, 1, np.random.default_rng(0)
-    )
+    c_order, _ = cd(params, visible, history, 1, np.random.default_rng(0))
+    f_order, _ = cd(params.copy("F"), visible, history, 1, np.random.default_rng(0))
     for name in ("weights", "hidden_bias", "visible_bias", "dynamic"):
         assert_allclose(
             getattr(c_order, name), getattr(f_order, name), rtol=1e-12, atol=1e-14
@@ -337,14 +248,13 @@ def test_cd_gradients_do_not_depend_on_memory_layout():
 def test_gibbs_frames_keep_observed_values_and_draw_as_before():
     params = make_params()
     visible, history = batch(params, n=8)
-    visible_bias, hidden_bias = dynamic_biases(params, history)
+    visible_bias, hidden_bias = params.dynamic_biases(history)
+    rbms = frames_of(params, hidden_bias, visible_bias)
     mask = np.zeros(visible.shape, dtype=bool)
     mask[:, :2] = True
     frames = gibbs_frames(
-        params,
+        rbms,
         visible,
-        visible_bias,
-        hidden_bias,
         5,
         np.random.default_rng(0),
         hidden_noise=0.5,
@@ -357,41 +267,12 @@ def test_gibbs_frames_keep_observed_values_and_draw_as_before():
     current = visible.copy()
     for _ in range(5):
         bias = hidden_bias + 0.5 * rng.standard_normal(hidden_bias.shape)
-        hidden = rng.random(hidden_bias.shape) < hidden_probabilities(
-            params, current, bias
-        )
+        hidden = rng.random(hidden_bias.shape) < frames_of(
+            params, bias
+        ).hidden_probabilities(current)
         current = hidden @ params.weights + visible_bias
         current[mask] = visible[mask]
-    current = hidden_probabilities(params, current, hidden_bias) @ params.weights
+    current = rbms.hidden_probabilities(current) @ params.weights
     current += visible_bias
     current[mask] = visible[mask]
     assert_allclose(frames, current, rtol=1e-12, atol=1e-12)
-
-
-@pytest.mark.parametrize("dtype", [np.float32, np.float64])
-@pytest.mark.parametrize("n", [4, 100])
-def test_history_noise_on_a_fraction_of_the_channels(dtype, n):
-    """Each frame's channel is noised at every lag or at none, drawn first."""
-    n_features, n_lags, fraction = 31, 3, 0.4
-    base = np.linspace(-1, 1, n * n_lags * n_features).reshape(n, -1).astype(dtype)
-    noisy = add_history_noise(
-        np.random.default_rng(5), base.copy(), 0.3, n_features, fraction
-    )
-    rng = np.random.default_rng(5)
-    noised = uniform(rng, (n, n_features), dtype) < fraction
-    added = noisy - base
-    expected = add_normal_noise(rng, np.zeros_like(base), 0.3) * np.tile(noised, n_lags)
-    assert_allclose(added, expected, rtol=1e-5, atol=1e-6)
-    blocks = added.reshape(n, n_lags, n_features) != 0
-    assert_array_equal(blocks, np.broadcast_to(noised[:, None], blocks.shape))
-    assert_array_equal(
-        add_history_noise(np.random.default_rng(5), base.copy(), 0.3, n_features, 1.0),
-        add_normal_noise(np.random.default_rng(5), base.copy(), 0.3),
-    )
-
-
-def test_history_noise_fraction_is_the_share_of_noised_channels():
-    history = np.zeros((2000, 3 * 10))
-    add_history_noise(np.random.default_rng(0), history, 1.0, 10, 0.3)
-    share = np.mean(history[:, :10] != 0)
-    assert abs(share - 0.3) < 0.01  # 20,000 Bernoulli(0.3): sd 0.0032

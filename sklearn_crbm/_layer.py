@@ -1,0 +1,367 @@
+"""The conditional layer: what every kind of layer provides, and its per-frame RBMs.
+
+A conditional layer models a frame ``v_t`` (visible units) with binary
+hidden units ``h``, given the frame's past ``x_{t-1}, ..., x_{t-L}`` (its
+*history*, ``L = n_lags`` frames flattened lag-major into one row) and,
+optionally, a per-frame *context* ``y_t`` (labels or other side
+information; a layer that has no use for it ignores it).  Given both, the
+layer is an RBM of the frame alone, with frame-specific parameters: a
+*frame RBM*.  Everything else in the package (training, generation and
+fill-in, the likelihood, the imputers) talks to layers only through this
+interface, so a new kind of layer is one new class (and its estimator).
+
+The interface
+-------------
+A layer is a :class:`~sklearn_crbm._parameters.PackedParameters` (its
+trainable arrays in one flat buffer) with
+
+``n_features``, ``n_components``, ``n_lags``, ``visible_type``
+    Visible units (the frame's channels), hidden units, past frames used,
+    and ``"gaussian"`` or ``"binary"`` visibles.
+``visible_std``
+    The standard deviation ``s`` of the Gaussian visibles, shape
+    ``(n_features,)``, or None for unit variance.
+``frame_rbms(history, context=None)``
+    The RBMs of ``n`` frames (:class:`FrameRBMs`) given their histories,
+    shape ``(n, n_lags * n_features)``, and contexts, shape ``(n,
+    n_context)`` or None.
+``conditioner()``
+    A callable like ``frame_rbms`` for a model that does not change while
+    it is used (generation, fill-in), which may keep what does not depend
+    on the frame.
+``new_workspace(batch_size)`` and ``cd_statistics(visible, history,
+context, cd_steps, rng, *, out, scale, workspace)``
+    Training: the contrastive-divergence statistics of a minibatch, each
+    group's ascent direction times ``scale``, written into ``out`` (a
+    buffer laid out like the layer), and the minibatch's summed squared
+    reconstruction error.
+``training_copy()``, ``fitted_copy()``, ``after_update()``
+    Hooks of the training loop (defaults: Fortran-ordered copy, C-ordered
+    copy, nothing): a copy in the coordinates training steps in, a copy of
+    those in the coordinates the fitted model keeps, and a projection after
+    every update.
+
+A :class:`FrameRBMs` holds each frame's dynamic biases ``c_hat_t``
+(visible) and ``b_hat_t`` (hidden) and provides the frame's interaction,
+the only part that differs between kinds of layers:
+
+``interaction_input(v)``
+    ``W_t (v / s)``, what the visibles add to each hidden unit's input;
+``interaction_field(h)``
+    ``s * (W_t^T h)``, what the hidden units add to each visible mean;
+``shared_weights``
+    ``W`` when every frame's ``W_t`` is the same matrix (the plain CRBM),
+    else None (a style-gated layer), so that the likelihood can enumerate
+    hidden configurations once for all frames.
+
+The energy of frame ``t``, in the form of Hinton's practical guide, is then
+
+    E(v, h) = sum_i (v_i - c_hat_i)^2 / (2 s_i^2) - b_hat . h - (v / s) . (W_t^T h)
+
+(binary visibles: ``-c_hat . v`` for the quadratic term, ``s = 1``), with
+``p(h_j = 1 | v) = sigmoid(b_hat_j + (W_t (v / s))_j)`` and ``p(v | h) =
+N(c_hat + s (W_t^T h), diag(s^2))`` (binary: ``sigmoid`` of it).
+"""
+
+import math
+
+import numpy as np
+
+from ._parameters import PackedParameters
+from .utils._array_api import array_ops
+from .utils._sequences import CHUNK_FRAMES, frame_history
+
+__all__ = [
+    "BINARY",
+    "GAUSSIAN",
+    "ConditionalLayer",
+    "FrameRBMs",
+    "TrainingWorkspace",
+    "logistic",
+    "sequence_frame_rbms",
+    "sequence_hidden_probabilities",
+]
+
+GAUSSIAN = "gaussian"
+BINARY = "binary"
+_LOG_SQRT_2PI = 0.5 * math.log(2 * math.pi)
+
+
+def logistic(activation, out=None):
+    """The logistic sigmoid ``1 / (1 + exp(-a))``, elementwise, in the dtype of ``a``.
+
+    The same formula as :func:`scipy.special.expit`, built from numpy's
+    vectorised ``exp`` (several times faster than ``expit`` on the arrays of a
+    minibatch); ``out`` may be ``activation`` itself.  Very negative inputs
+    overflow ``exp`` to ``inf`` and give exactly 0, very positive ones
+    underflow it to 0 and give exactly 1, without a warning.
+    """
+    ops = array_ops(activation)
+    out = ops.negative(activation, out=out)
+    with np.errstate(over="ignore", under="ignore"):
+        out = ops.exp(out, out=out)
+    out += 1
+    return ops.divide(1, out, out=out)  # numpy's reciprocal is not vectorised
+
+
+class FrameRBMs:
+    """The RBMs of a set of frames: one layer given each frame's past and context.
+
+    Subclasses (one per kind of layer) compute the interaction of each
+    frame's visible and hidden units; this class holds the dynamic biases
+    and everything that follows from the interaction.
+
+    Parameters
+    ----------
+    visible_bias : ndarray of shape (n_frames, n_features)
+        ``c_hat`` of every frame.
+    hidden_bias : ndarray of shape (n_frames, n_components)
+        ``b_hat`` of every frame.
+    visible_std : ndarray of shape (n_features,) or None
+        ``s`` of the Gaussian visibles; None for unit variance (and binary
+        visibles).
+    binary : bool
+        Whether the visibles are binary.
+    """
+
+    # arrays with one row per frame, which take() selects
+    _row_arrays = ("visible_bias", "hidden_bias")
+    # arrays shared by every frame, which astype() converts with the rows
+    _shared_arrays = ("visible_std",)
+
+    def __init__(self, visible_bias, hidden_bias, visible_std, binary):
+        self.visible_bias = visible_bias
+        self.hidden_bias = hidden_bias
+        self.visible_std = visible_std
+        self.binary = binary
+
+    # ------------------------------------------------------------ subclasses
+
+    @property
+    def shared_weights(self):
+        """``W`` (n_components, n_features) when it is every frame's, else None."""
+        return None
+
+    def interaction_input(self, visible, out=None):
+        """``W_t (v / s)`` of every frame's row of ``visible``."""
+        raise NotImplementedError
+
+    def interaction_field(self, hidden, out=None):
+        """``s * (W_t^T h)`` of every frame's row of ``hidden``."""
+        raise NotImplementedError
+
+    # -------------------------------------------------------------- generic
+
+    @property
+    def ops(self):
+        return array_ops(self.visible_bias)
+
+    @property
+    def dtype(self):
+        return self.visible_bias.dtype
+
+    @property
+    def n_frames(self):
+        return self.visible_bias.shape[0]
+
+    @property
+    def n_features(self):
+        return self.visible_bias.shape[1]
+
+    @property
+    def n_components(self):
+        return self.hidden_bias.shape[1]
+
+    @property
+    def scale(self):
+        """``s``, ones for unit variance."""
+        if self.visible_std is not None and not self.binary:
+            return self.visible_std
+        return self.ops.ones(self.n_features, dtype=self.dtype)
+
+    def _replace(self, **arrays):
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new.__dict__.update(arrays)
+        return new
+
+    def take(self, rows):
+        """The RBMs of frames ``rows`` (an index array or a slice)."""
+        ops = self.ops
+        arrays = {}
+        for name in self._row_arrays:
+            value = getattr(self, name)
+            if value is not None:
+                arrays[name] = (
+                    value[rows, ...]
+                    if isinstance(rows, slice)
+                    else ops.take(value, rows, axis=0)
+                )
+        return self._replace(**arrays)
+
+    def astype(self, dtype):
+        """The same RBMs computing in ``dtype``."""
+        if dtype == self.dtype:
+            return self
+        ops = self.ops
+        arrays = {}
+        for name in (*self._row_arrays, *self._shared_arrays):
+            value = getattr(self, name)
+            if value is not None:
+                arrays[name] = ops.astype(value, dtype)
+        return self._replace(**arrays)
+
+    def hidden_input(self, visible, out=None):
+        """``b_hat + W_t (v / s)``: each hidden unit's input."""
+        activation = self.interaction_input(visible, out=out)
+        activation += self.hidden_bias
+        return activation
+
+    def hidden_probabilities(self, visible, out=None):
+        """``p(h = 1 | v, past) = sigmoid(b_hat + W_t (v / s))`` (paper Eq. 2)."""
+        activation = self.hidden_input(visible, out=out)
+        return logistic(activation, out=activation)
+
+    def visible_mean(self, hidden, out=None):
+        """``E[v | h, past] = c_hat + s (W_t^T h)`` (paper Eq. 3), or its sigmoid."""
+        mean = self.interaction_field(hidden, out=out)
+        mean += self.visible_bias
+        if self.binary:
+            mean = logistic(mean, out=mean)
+        return mean
+
+    def gaussian_normaliser(self):
+        """``sum_i log(sqrt(2 pi) s_i)``: the visible integral's constant (or 0)."""
+        if self.binary:
+            return 0.0
+        ops = self.ops
+        return float(ops.sum(ops.log(self.scale)) + self.n_features * _LOG_SQRT_2PI)
+
+    def negative_free_energy(self, visible):
+        """``-F(v)`` of every frame's own row of ``visible``: ``log sum_h exp(-E)``."""
+        ops = self.ops
+        softplus = ops.sum(ops.logaddexp(0, self.hidden_input(visible)), axis=1)
+        if self.binary:
+            return ops.einsum("ij,ij->i", visible, self.visible_bias) + softplus
+        residual = (visible - self.visible_bias) / self.scale
+        return softplus - 0.5 * ops.einsum("ij,ij->i", residual, residual)
+
+
+class TrainingWorkspace:
+    """Buffers a training loop gathers each minibatch into, reused between them.
+
+    ``visible(n)`` and ``history`` hold the minibatch's frames and their
+    histories; a layer's workspace adds the buffers its ``cd_statistics``
+    needs.
+    """
+
+    def __init__(self, layer, batch_size):
+        ops, dtype = layer.ops, layer.dtype
+        self.batch_size = batch_size
+        self._visible = ops.empty((batch_size, layer.n_features), dtype)
+        self.history = ops.empty((batch_size, layer.n_lags * layer.n_features), dtype)
+
+    def visible(self, n):
+        """Where to gather the visible frames of a minibatch of ``n`` frames."""
+        return self._visible[:n, ...]
+
+
+class ConditionalLayer(PackedParameters):
+    """Base class of the kinds of conditional layer (see the module docstring).
+
+    Attributes
+    ----------
+    n_features, n_components, n_lags : int
+    visible_type : {"gaussian", "binary"}
+    """
+
+    n_features: int
+    n_components: int
+    n_lags: int
+    visible_type: str = GAUSSIAN
+
+    @property
+    def binary(self):
+        return self.visible_type == BINARY
+
+    @property
+    def visible_std(self):
+        """``s``, shape ``(n_features,)``; None for unit variance."""
+        return None
+
+    def frame_rbms(self, history, context=None):
+        """The frame RBMs of ``n`` frames given their histories and contexts."""
+        raise NotImplementedError
+
+    def conditioner(self):
+        """``frame_rbms`` for a model that stays as it is while it is used."""
+        return self.frame_rbms
+
+    def new_workspace(self, batch_size):
+        return TrainingWorkspace(self, batch_size)
+
+    def cd_statistics(
+        self, visible, history, context, cd_steps, rng, *, out, scale, workspace
+    ):
+        """Contrastive-divergence statistics of a minibatch times ``scale``, in ``out``.
+
+        Returns ``out`` and the summed squared reconstruction error (a float
+        on numpy, a 0-d array of the namespace otherwise).
+        """
+        raise NotImplementedError
+
+    def training_copy(self):
+        """The parameters training updates: a copy in the layout BLAS runs fastest."""
+        return self.copy(layout="F")
+
+    def fitted_copy(self):
+        """Parameters from :meth:`training_copy` as the fitted model keeps them."""
+        return self.copy(layout="C")
+
+    def after_update(self):
+        """Called after every training update of these parameters."""
+
+
+def sequence_frame_rbms(layer, X, sequences, frames=None, context=None):
+    """Yield ``(rows, rbms)`` for frames of ``X``, chunk by chunk.
+
+    The frame RBMs of every frame in ``frames`` (default: all) given its past
+    frames in its own sequence and its row of ``context``; a lag reaching
+    before the start of a sequence reads the sequence's first frame instead
+    (edge padding).
+
+    Parameters
+    ----------
+    layer : ConditionalLayer
+    X : ndarray of shape (n_frames, n_features)
+        Long format.
+    sequences : Sequences
+        From :func:`~sklearn_crbm.utils._sequences.check_sequence_ids`.
+    frames : ndarray of int, default=None
+    context : ndarray of shape (n_frames, n_context), default=None
+
+    Yields
+    ------
+    rows : ndarray of int
+        Up to ``CHUNK_FRAMES`` entries of ``frames``.
+    rbms : FrameRBMs
+    """
+    frames = np.arange(X.shape[0]) if frames is None else frames
+    starts = sequences.frame_starts()
+    ops = array_ops(X)
+    for lo in range(0, len(frames), CHUNK_FRAMES):
+        rows = frames[lo : lo + CHUNK_FRAMES]
+        history = frame_history(X, rows, layer.n_lags, starts[rows])
+        rows_context = None if context is None else ops.take(context, rows, axis=0)
+        yield rows, layer.frame_rbms(history, rows_context)
+
+
+def sequence_hidden_probabilities(layer, X, sequences, context=None):
+    """``p(h = 1 | x_t, history)`` of every frame of ``X``, edge padded."""
+    ops = layer.ops
+    hidden = ops.empty((X.shape[0], layer.n_components), dtype=X.dtype)
+    for rows, rbms in sequence_frame_rbms(layer, X, sequences, context=context):
+        if ops is not np:  # every frame: ranges, basic indexing
+            rows = slice(int(rows[0]), int(rows[-1]) + 1)
+        hidden[rows, ...] = rbms.hidden_probabilities(X[rows, ...])
+    return hidden

@@ -1,0 +1,246 @@
+"""Training any conditional layer by contrastive divergence, epoch by epoch.
+
+:func:`train_epochs` runs the loop every estimator shares: minibatches
+gathered by index arithmetic, noise on their histories, the layer's own
+CD statistics (:meth:`~sklearn_crbm._layer.ConditionalLayer.cd_statistics`),
+momentum and weight decay (:class:`~sklearn_crbm._parameters.MomentumUpdate`),
+parameter averaging, and a check for divergence after every epoch.
+:class:`ProgressMonitor` reports what ``verbose`` asks for.
+"""
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._gibbs import mean_field_prediction
+from ._parameters import MomentumUpdate, ParameterAverage
+from .utils._array_api import array_ops, array_random, to_device_batches
+from .utils._random import add_history_noise, rng_from
+from .utils._sequences import balanced_batches, frame_history, shuffled_batches
+
+__all__ = ["ProgressMonitor", "Schedule", "TrainingDivergedError", "train_epochs"]
+
+# Frames the progress report predicts one step ahead (evenly spaced).
+MONITOR_FRAMES = 1000
+# Mean-field iterations of those predictions.
+MONITOR_MEAN_FIELD_STEPS = 10
+
+
+class TrainingDivergedError(FloatingPointError):
+    """Training produced non-finite weights (the learning rate is too large)."""
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """How an estimator trains: its hyper-parameters of contrastive divergence."""
+
+    learning_rate: float
+    momentum: float
+    momentum_delay: int
+    weight_decay: float
+    cd_steps: int
+    batch_size: int
+    batching: str
+    history_noise: float
+    history_noise_fraction: float
+
+    @classmethod
+    def of(cls, estimator):
+        """The schedule an estimator's parameters of the same names give."""
+        params = estimator.get_params(deep=False)
+        return cls(**{name: params[name] for name in cls.__dataclass_fields__})
+
+
+class ProgressMonitor:
+    """What a training loop prints with ``verbose``: is the model learning?
+
+    Every ``verbose`` epochs: the epoch, the one-step prediction error of
+    the model on (up to ``MONITOR_FRAMES``) training frames, as the root mean
+    squared error per channel of the mean-field prediction of each frame
+    from its clean past, beside that of simply repeating the previous frame,
+    the mean squared reconstruction error of the epoch, and the time.  A
+    model that learns predicts better than the previous frame, and better
+    as training goes on.
+
+    Parameters
+    ----------
+    name : str
+        The estimator's class name.
+    verbose : int
+        Report every ``verbose`` epochs (0: never).
+    X : ndarray of shape (n_frames, n_features)
+    frames : ndarray of int
+        The trainable frames.
+    context : ndarray of shape (n_frames, n_context) or None
+    """
+
+    def __init__(self, name, verbose, X, frames, context=None):
+        self.name = name
+        self.verbose = verbose
+        self._start = time.perf_counter()
+        if not verbose:
+            return
+        picks = frames
+        if len(frames) > MONITOR_FRAMES:
+            picks = frames[np.linspace(0, len(frames) - 1, MONITOR_FRAMES).astype(int)]
+        ops = array_ops(X)
+        self._rows = picks
+        self._X = X
+        self._targets = ops.take(X, picks, axis=0)
+        self._context = None if context is None else ops.take(context, picks, axis=0)
+        previous = ops.take(X, picks - 1, axis=0)
+        self.previous_frame_error = _rms(self._targets - previous)
+
+    def one_step_error(self, layer):
+        """RMS error per channel of the layer's one-step predictions."""
+        history = frame_history(self._X, self._rows, layer.n_lags)
+        rbms = layer.frame_rbms(history, self._context)
+        prediction = mean_field_prediction(rbms, MONITOR_MEAN_FIELD_STEPS)
+        return _rms(self._targets - prediction)
+
+    def is_due(self, epoch):
+        """Whether ``epoch`` (counted from 1) is one to report."""
+        return bool(self.verbose) and epoch % self.verbose == 0
+
+    def report(self, epoch, layer, reconstruction_error):
+        """Print the line of ``epoch`` for the layer as it is after it."""
+        error = self.one_step_error(layer)
+        print(
+            f"[{self.name}] epoch {epoch}: one-step error {error:.4f} "
+            f"(previous frame: {self.previous_frame_error:.4f}), reconstruction "
+            f"error {reconstruction_error:.4f}, time "
+            f"{time.perf_counter() - self._start:.1f}s"
+        )
+
+
+def _rms(difference):
+    ops = array_ops(difference)
+    return float(ops.sqrt(ops.mean(difference * difference)))
+
+
+# Diverging weights overflow in the products before the epoch's check
+# raises TrainingDivergedError, which says what to do.
+@np.errstate(over="ignore", invalid="ignore")
+def train_epochs(
+    layer,
+    velocity,
+    X,
+    frames,
+    schedule,
+    random_state,
+    n_epochs,
+    *,
+    epochs_done=0,
+    context=None,
+    n_averaged=0,
+    monitor=None,
+):
+    """``n_epochs`` epochs of contrastive divergence on the frames of ``X``.
+
+    Parameters
+    ----------
+    layer : ConditionalLayer
+        The start; not changed.
+    velocity : PackedParameters or None
+        The momentum carried over from earlier epochs (None: zeros).
+    X : ndarray of shape (n_frames, n_features)
+    frames : ndarray of int
+        The trainable frames (those with a full past in their sequence).
+    schedule : Schedule
+    random_state : RandomState
+        Draws one seed per epoch (minibatches, then the math's draws).
+    n_epochs : int
+    epochs_done : int, default=0
+        Epochs trained before (momentum starts after ``momentum_delay``).
+    context : ndarray of shape (n_frames, n_context), default=None
+        Every frame's context, for a layer that uses one.
+    n_averaged : int, default=0
+        The layer returned is the mean of the parameters at the ends of the
+        last ``n_averaged`` epochs (0: the last epoch's).
+    monitor : ProgressMonitor, default=None
+
+    Returns
+    -------
+    layer : ConditionalLayer
+        The trained parameters, in the fitted form (C order).
+    velocity : PackedParameters
+        The momentum, to carry over.
+    reconstruction_error : float
+        Mean squared reconstruction error per frame of the last epoch.
+
+    Raises
+    ------
+    TrainingDivergedError
+        When the parameters become non-finite.
+    """
+    params = layer.training_copy()
+    update = MomentumUpdate(params, velocity)
+    # Minibatches gather rows: from a Fortran-ordered X (what many
+    # transformers return) every row would be a strided read.
+    ops = array_ops(X)
+    X = ops.ascontiguousarray(X)
+    plan_batches = (
+        balanced_batches if schedule.batching == "balanced" else shuffled_batches
+    )
+    workspace = params.new_workspace(schedule.batch_size)
+    noise_buffer = ops.empty_like(workspace.history) if schedule.history_noise else None
+    average = ParameterAverage()
+    reconstruction_error = math.nan
+    for epoch in range(n_epochs):
+        rng = rng_from(random_state)
+        # minibatches are planned with numpy; the math draws on X's device
+        math_rng = array_random(rng, X)
+        done = epochs_done + epoch
+        momentum = schedule.momentum if done >= schedule.momentum_delay else 0.0
+        squared_error = 0.0
+        batches = plan_batches(frames, schedule.batch_size, rng)
+        if ops is not np:  # the epoch's plan reaches the device in one copy
+            batches = to_device_batches(batches, ops)
+        for batch in batches:
+            n = batch.shape[0]
+            visible = ops.take(X, batch, axis=0, out=workspace.visible(n), mode="clip")
+            history = frame_history(
+                X, batch, params.n_lags, out=workspace.history[:n, ...]
+            )
+            if schedule.history_noise:
+                add_history_noise(
+                    math_rng,
+                    history,
+                    schedule.history_noise,
+                    X.shape[1],
+                    schedule.history_noise_fraction,
+                    noise_buffer[:n, ...],
+                )
+            batch_context = (
+                None if context is None else ops.take(context, batch, axis=0)
+            )
+            _, error = params.cd_statistics(
+                visible,
+                history,
+                batch_context,
+                schedule.cd_steps,
+                math_rng,
+                out=update.statistics,
+                scale=schedule.learning_rate / n,
+                workspace=workspace,
+            )
+            squared_error += error
+            update.apply(momentum, schedule.learning_rate, schedule.weight_decay)
+            params.after_update()
+        squared_error = float(squared_error)  # one device sync per epoch
+        reconstruction_error = squared_error / len(frames)
+        if not params.is_finite() or not math.isfinite(squared_error):
+            raise TrainingDivergedError(
+                f"Training diverged at epoch {done + 1}: the weights became "
+                f"non-finite with learning_rate={schedule.learning_rate}. Lower the "
+                "learning rate (and momentum), and standardise the data, e.g. "
+                "with sklearn_crbm.preprocessing.StandardScaler."
+            )
+        if monitor is not None and monitor.is_due(done + 1):
+            monitor.report(done + 1, params.fitted_copy(), reconstruction_error)
+        if epoch >= n_epochs - n_averaged:
+            average.add(params.fitted_copy())
+    fitted = average.mean if average.count else params.fitted_copy()
+    return fitted, update.velocity, reconstruction_error
