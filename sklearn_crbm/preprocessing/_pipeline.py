@@ -8,6 +8,7 @@ from sklearn.pipeline import Pipeline
 from sklearn.utils.metaestimators import available_if
 
 from ..datasets import write_amc, write_bvh
+from ..datasets._up_axis import check_up_axis
 from ..metrics import forward_speed
 from ..utils import random_windows
 from ._data import StandardScaler
@@ -92,11 +93,27 @@ class MotionPipeline(Pipeline):
 
     def fit(self, X, y=None, **params):
         _check_routing(params)
+        self._check_up_axis(X)
         return super().fit(X, y, **params)
 
     def fit_transform(self, X, y=None, **params):
         _check_routing(params)
+        self._check_up_axis(X)
         return super().fit_transform(X, y, **params)
+
+    def _check_up_axis(self, X):
+        """Warn when a root encoder's explicit ``up_axis`` is not the one the
+        raw motion stands along (see ``Skeleton.detect_up_axis``)."""
+        for name, step in self.steps:
+            skeleton = getattr(step, "skeleton", None)
+            setting = getattr(step, "up_axis", None)
+            if not isinstance(step, RootRelativeEncoder) or None in (skeleton, setting):
+                continue
+            if np.shape(X)[1:] != (len(skeleton.feature_names),):
+                continue  # not the skeleton's raw channels: nothing to detect on
+            names = getattr(X, "columns", None)
+            detected = skeleton.detect_up_axis(np.asarray(X, dtype=np.float64), names)
+            check_up_axis(setting, detected, f"Step {name!r} sets", stacklevel=4)
 
     @property
     def skeleton(self):
@@ -407,11 +424,12 @@ def make_motion_preprocessor(
         (``"mean"``) or from the rest pose (``"rest"``, the paper); see
         :class:`ExpMapEncoder`.
     up_axis : {"x", "y", "z"} or None, default=None
-        Vertical axis; None takes ``skeleton.up_axis`` (``"y"`` for ASF and
-        BVH files, ``"z"`` for the MIT data).  The body's forward axis is the
-        next one cyclically (y up: z forward; z up: x forward).  Fitting warns
-        when the root's forward axis is nearly vertical in most frames, the
-        sign of a wrong up axis.
+        Vertical axis; None takes ``skeleton.up_axis``, which the file
+        readers detect from the motion (see
+        :meth:`~sklearn_crbm.datasets.Skeleton.detect_up_axis`; ``"z"`` for
+        the MIT data).  The body's forward axis is the next one cyclically
+        (y up: z forward; z up: x forward).  Fitting warns when an axis given
+        here is not the one the motion stands along.
     roll : {"euler", "taylor"}, default="euler"
         How the root's roll is encoded; see :class:`RootRelativeEncoder`.
     with_mean, with_std : bool, default=True
