@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import sklearn
 from numpy.testing import assert_allclose, assert_array_equal
-from sklearn.base import clone
+from sklearn.base import BaseEstimator, TransformerMixin, clone
 from sklearn.model_selection import GridSearchCV, GroupKFold
 
 from sklearn_crbm import ConditionalRBM
@@ -90,13 +90,17 @@ def test_style_windows_are_real_frames_of_one_style_in_one_sequence(fitted, walk
     # label the first half of every sequence "slow", the second "fast"
     position = np.concatenate([np.arange(40)] * 4)
     styles = np.where(position < 20, "slow", "fast")
-    windows = fitted.style_windows(
-        walker.data,
-        styles,
-        sequence_ids=walker.sequence_ids,
-        n_windows=30,
-        random_state=0,
-    )
+
+    def draw():
+        return fitted.style_windows(
+            walker.data,
+            styles,
+            sequence_ids=walker.sequence_ids,
+            n_windows=30,
+            random_state=0,
+        )
+
+    windows = draw()
     assert list(windows) == ["slow", "fast"]
     Z = fitted[:-1].transform(walker.data, sequence_ids=walker.sequence_ids)
     width = fitted[-1].history_length
@@ -108,13 +112,7 @@ def test_style_windows_are_real_frames_of_one_style_in_one_sequence(fitted, walk
             assert_array_equal(Z[rows], window)
             assert len(set(walker.sequence_ids[rows])) == 1
             assert set(styles[rows]) == {style}
-    again = fitted.style_windows(
-        walker.data,
-        styles,
-        sequence_ids=walker.sequence_ids,
-        n_windows=30,
-        random_state=0,
-    )
+    again = draw()
     for style in windows:
         assert_array_equal(again[style], windows[style])
     raw = fitted.sample(6, history=windows["fast"][:2], random_state=0)
@@ -155,3 +153,33 @@ def test_write_motion_writes_bvh_and_amc_that_read_back(fitted, walker, tmp_path
         fitted.write_motion(tmp_path / "walk.bvh", raw)
     with pytest.raises(ValueError, match=r"\*\.bvh or \*\.amc"):
         fitted.write_motion(tmp_path / "walk.txt", raw)
+
+
+class _StyleModel(TransformerMixin, BaseEstimator):
+    """A stand-in for a style model: ``sample`` takes a ``style``."""
+
+    history_length = 1
+
+    def fit(self, X, y=None):
+        self.n_features_in_ = X.shape[1]
+        self.mean_ = X.mean(axis=0)
+        return self
+
+    def transform(self, X):
+        return X
+
+    def sample(
+        self, n_frames, *, history=None, style, n_sequences=1, random_state=None
+    ):
+        shift = {"walk": 0.0, "jog": 1.0}[style]
+        return np.tile(self.mean_ + shift, (n_sequences * n_frames, 1))
+
+
+def test_sample_passes_keywords_through_to_the_models_sample(walker):
+    pipe = make_motion_pipeline(walker.skeleton, _StyleModel())
+    pipe.fit(walker.data, sequence_ids=walker.sequence_ids)
+    walk, jog = (pipe.sample(4, n_sequences=2, style=s) for s in ("walk", "jog"))
+    assert walk.shape == jog.shape == (8, walker.data.shape[1])
+    assert not np.allclose(walk, jog)
+    with pytest.raises(TypeError, match="style"):
+        pipe.sample(4)
