@@ -1,17 +1,22 @@
 """The documentation builds without warnings, and its code runs.
 
-``test_docs_build`` runs ``sphinx-build -W --keep-going -b html doc <tmp>``
-(warnings are errors) without executing the gallery examples, as CI and a
-contributor do after ``pip install -e ".[docs]"``, and checks the key pages.
+``test_docs_build`` runs ``sphinx-build -W --keep-going -b html`` (warnings
+are errors) without executing the gallery examples, as CI and a contributor
+do after ``pip install -e ".[docs]"``, and checks the key pages.  It builds a
+copy of ``doc`` in a temporary folder, so the files a build generates among
+the sources (``api.rst``, ``generated/``, ``auto_examples/``...) never land in
+the checkout.
 ``test_user_guide_code`` runs the ``>>>`` examples of the hand-written pages
 (getting started, user guide) as doctests, so the guide cannot fall behind the
 code.
 """
 
+import ast
 import doctest
 import io
 import os
 import re
+import shutil
 import subprocess
 import sys
 from contextlib import redirect_stdout
@@ -31,12 +36,30 @@ CODE_PAGES = sorted(
 )
 
 
+def _tree(folder):
+    """Every file and folder below ``folder``, ignored ones included."""
+    return sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*"))
+
+
 @pytest.fixture(scope="module")
-def html_dir(tmp_path_factory):
-    """Build the HTML documentation once; return the output folder."""
-    out = tmp_path_factory.mktemp("docs") / "html"
+def docs_build(tmp_path_factory, data_home):
+    """Build the HTML documentation once from a copy of ``doc``.
+
+    Returns ``(source, html, doc_tree_before)``: the copied source folder (it
+    holds what the build generated), the output folder, and the checkout's
+    ``doc`` tree before the build.
+    """
+    before = _tree(DOC_DIR)
+    # the copy keeps the layout the docs expect: the package and benchmarks
+    # beside the doc folder
+    repo = tmp_path_factory.mktemp("docs") / "repo"
+    shutil.copytree(DOC_DIR, repo / "doc", ignore=shutil.ignore_patterns(*GENERATED))
+    for name in ("sklearn_crbm", "benchmarks"):
+        (repo / name).symlink_to(REPO_ROOT / name, target_is_directory=True)
+    out = repo.parent / "html"
     env = dict(os.environ)
     env["SKLEARN_CRBM_DOCS_RUN_EXAMPLES"] = "0"  # gallery shown, not executed
+    env["SKLEARN_CRBM_DATA"] = str(data_home)
     env.setdefault("MPLBACKEND", "Agg")
     command = [
         sys.executable,
@@ -48,8 +71,8 @@ def html_dir(tmp_path_factory):
         "-b",
         "html",
         "-d",
-        str(out.parent / "doctrees"),
-        str(DOC_DIR),
+        str(repo.parent / "doctrees"),
+        str(repo / "doc"),
         str(out),
     ]
     result = subprocess.run(
@@ -71,7 +94,16 @@ def html_dir(tmp_path_factory):
             + result.stdout[-5000:]
             + result.stderr[-10000:]
         )
-    return out
+    return repo / "doc", out, before
+
+
+# What a build writes among the sources (doc/.gitignore), left out of the copy.
+GENERATED = ("_build", "api.rst", "generated", "auto_examples", "gen_modules")
+
+
+@pytest.fixture(scope="module")
+def html_dir(docs_build):
+    return docs_build[1]
 
 
 def test_docs_build(html_dir):
@@ -106,9 +138,16 @@ def test_docs_build(html_dir):
         assert f'id="sklearn_crbm.ConditionalRBM.{method}"' in rbm, method
 
 
-def test_api_reference_covers_every_public_name(html_dir):
+def test_docs_build_leaves_the_checkout_untouched(docs_build):
+    source, _, before = docs_build
+    assert _tree(DOC_DIR) == before
+    assert (source / "api.rst").is_file()  # generated in the copy instead
+
+
+def test_api_reference_covers_every_public_name(docs_build):
     """Every name in a public module's ``__all__`` has its page."""
-    api = (DOC_DIR / "api.rst").read_text(encoding="utf-8")
+    source, html_dir, _ = docs_build
+    api = (source / "api.rst").read_text(encoding="utf-8")
     modules = re.findall(r"^\.\. currentmodule:: (\S+)$", api, flags=re.M)
     assert "sklearn_crbm" in modules
     documented = {p.stem for p in (html_dir / "generated").glob("*.html")}
@@ -146,3 +185,65 @@ def test_user_guide_code(page):
         )
     assert attempted > 0
     assert failed == 0, output.getvalue()
+
+
+# Calls whose value (a matplotlib artist) sphinx-gallery would print as a
+# stray line such as ``Text(0.5, 1.0, '...')`` when a cell ends with one.
+_ARTIST_CALLS = re.compile(
+    r"\.(set_\w+|plot|scatter|errorbar|annotate|legend|imshow|text|bar|hist)$"
+)
+
+
+def _gallery_problems(source):
+    """What keeps a gallery page from showing each figure whole and alone.
+
+    sphinx-gallery captures the figures at the end of each cell (``# %%``):
+    a later cell drawing on a figure of an earlier one draws on a figure the
+    page has already shown (the earlier cell's panels stay empty), and a cell
+    ending with an artist-returning call prints its ``repr``.
+    """
+    problems, figures = [], {}
+    for k, cell in enumerate(re.split(r"^# %%.*$", source, flags=re.M)):
+        tree = ast.parse(cell)
+        bound = set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Assign) and isinstance(node.value, ast.Call):
+                if ast.unparse(node.value.func) in ("plt.subplots", "plt.figure"):
+                    for target in node.targets:
+                        bound |= {
+                            n.id for n in ast.walk(target) if isinstance(n, ast.Name)
+                        }
+        used = {
+            n.id
+            for n in ast.walk(tree)
+            if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)
+        }
+        for name in sorted((used & set(figures)) - bound):
+            problems.append(f"cell {k} draws on {name!r} of cell {figures[name]}")
+        figures.update(dict.fromkeys(bound, k))
+        last = tree.body[-1] if tree.body else None
+        if isinstance(last, ast.Expr) and isinstance(last.value, ast.Call):
+            function = ast.unparse(last.value.func)
+            if _ARTIST_CALLS.search(function):
+                problems.append(f"cell {k} ends with {function}(...)")
+    return problems
+
+
+@pytest.mark.parametrize(
+    "example", sorted(p.name for p in (DOC_DIR / "examples").glob("plot_*.py"))
+)
+def test_gallery_cells_draw_each_figure_whole(example):
+    source = (DOC_DIR / "examples" / example).read_text(encoding="utf-8")
+    assert _gallery_problems(source) == []
+
+
+def test_gallery_check_finds_a_figure_drawn_across_cells():
+    source = (
+        "fig, ax = plt.subplots(1, 2)\nax[0].plot(x)\nax[0].set_title('a')\n"
+        "# %%\nax[1].plot(y)\nfig.savefig(path)\n"
+    )
+    assert _gallery_problems(source) == [
+        "cell 0 ends with ax[0].set_title(...)",
+        "cell 1 draws on 'ax' of cell 0",
+        "cell 1 draws on 'fig' of cell 0",
+    ]

@@ -8,6 +8,7 @@ from ._asf import content_lines
 from ._channels import frame_columns
 from ._parsing import format_number, parse_error, parse_floats
 from ._skeleton import Skeleton
+from ._up_axis import check_up_axis
 
 __all__ = ["read_amc", "write_amc"]
 
@@ -39,6 +40,12 @@ def read_amc(path, skeleton):
         message names the file and line.
     TypeError
         If ``skeleton`` is neither a Skeleton nor a path.
+
+    Warns
+    -----
+    UserWarning
+        If the motion stands along another axis than ``skeleton.up_axis``
+        (see :meth:`Skeleton.detect_up_axis`).
 
     Examples
     --------
@@ -78,6 +85,9 @@ def read_amc(path, skeleton):
             "(empty or truncated file?)",
         )
     data = np.array(frames, dtype=np.float64).reshape(len(frames), n_features)
+    check_up_axis(
+        skeleton.up_axis, skeleton.detect_up_axis(data), f"{path}: its skeleton has"
+    )
     return data, skeleton.feature_names
 
 

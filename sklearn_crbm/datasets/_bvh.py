@@ -9,6 +9,7 @@ from ._channels import EULER_CHANNELS, TRANSLATION_CHANNELS
 from ._frame_rate import check_rate
 from ._parsing import format_number, parse_error, parse_floats
 from ._skeleton import Skeleton
+from ._up_axis import UP_AXIS_COMMENT, declared_up_axis, settle_up_axis
 
 __all__ = ["read_bvh", "write_bvh"]
 
@@ -26,7 +27,12 @@ def read_bvh(path):
     -------
     skeleton : Skeleton
         From the HIERARCHY, ``convention="bvh"``; end sites are bones named
-        ``"{parent}_end"`` without channels.
+        ``"{parent}_end"`` without channels.  Its ``up_axis`` is the one the
+        file declares (:func:`write_bvh` writes it in a comment on the first
+        line), else
+        the one the motion stands along (:meth:`Skeleton.detect_up_axis`):
+        the axis to give Blender's importer as *Up*.  A file whose declared
+        axis is not the one its motion stands along gets a warning.
     data : ndarray of shape (n_frames, n_features)
         The MOTION values, positions in file units and angles in degrees.
     feature_names : ndarray of str
@@ -60,6 +66,7 @@ def read_bvh(path):
     n_channels = len(skeleton.feature_names)
     n_frames, frame_time, rows = _parse_motion_header(path, motion)
     data = _parse_rows(path, rows, n_channels, n_frames, motion[-1][0])
+    settle_up_axis(skeleton, path, declared_up_axis(header), data)
     return skeleton, data, skeleton.feature_names, 1.0 / frame_time
 
 
@@ -146,9 +153,11 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None, *, root=None
     bone, and leaf bones get an end site at their end; so the ASF position of
     a bone (its end) is the BVH position of its children, or of its end site
     ``"{bone}_end"``.  MIT offset channels (``ox``, ``oy``, ``oz``) are not
-    written: the joint offsets hold them.  BVH has no up axis; positions are
-    written in the skeleton's own axes (z up for MIT data) and
-    :func:`read_bvh` reports ``up_axis="y"``.
+    written: the joint offsets hold them.  Positions are written in the
+    skeleton's own axes (z up for MIT data).  BVH has no up axis: the first
+    line, ``HIERARCHY # sklearn_crbm up_axis {axis}``, declares
+    ``skeleton.up_axis`` in a comment that :func:`read_bvh` reads back and
+    other readers (Blender, pybvh, bvhio, bvhtoolbox) skip.
 
     Parameters
     ----------
@@ -213,7 +222,7 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None, *, root=None
     }
     try:
         joints = _bvh_joints(skeleton, motion["offsets"])
-        lines = ["HIERARCHY"]
+        lines = ["HIERARCHY " + UP_AXIS_COMMENT.format(axis=skeleton.up_axis)]
         _hierarchy_lines(skeleton, joints, skeleton.bones[0].name, 0, lines)
     except RecursionError:
         raise ValueError(

@@ -11,6 +11,7 @@ import numpy as np
 from ._bone import Bone
 from ._channels import EULER_CHANNELS
 from ._parsing import parse_error, parse_floats, read_lines
+from ._up_axis import without_up_axis_comment
 
 __all__ = ["CHANNEL_TO_BVH", "parse_bvh_hierarchy", "split_header"]
 
@@ -171,6 +172,7 @@ def parse_bvh_hierarchy(path, header=None):
     :meth:`Skeleton.from_bvh`."""
     if header is None:
         header, _ = split_header(path)
+    header = without_up_axis_comment(header)
     return {
         "bones": _parse_hierarchy(_Tokens(path, header)),
         "name": Path(path).stem,

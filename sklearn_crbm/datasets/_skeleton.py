@@ -31,7 +31,7 @@ import numpy as np
 from ..utils._rotations import euler_to_matrix, expmap_to_matrix
 from ._asf import parse_asf
 from ._bone import Bone
-from ._bvh_hierarchy import parse_bvh_hierarchy
+from ._bvh_hierarchy import parse_bvh_hierarchy, split_header
 from ._channels import (
     EXPMAP_CHANNELS,
     OFFSET_CHANNELS,
@@ -39,6 +39,7 @@ from ._channels import (
     frame_columns,
 )
 from ._mit import parse_mit_skeleton
+from ._up_axis import declared_up_axis, detect_up_axis, settle_up_axis
 
 __all__ = ["Skeleton"]
 
@@ -58,7 +59,8 @@ class Skeleton:
     name : str, default="skeleton"
         A name for the skeleton.
     up_axis : {"x", "y", "z"}, default="y"
-        The vertical axis: ``"y"`` for CMU and BVH data, ``"z"`` for MIT.
+        The vertical axis: ``"y"`` for CMU data, ``"z"`` for MIT.  The file
+        readers detect it (see :meth:`detect_up_axis`).
     angle_unit : {"deg", "rad"}, default="deg"
         Unit of the Euler channels.  Exponential maps are always in radians
         and ``axis`` pre-rotations always in degrees.
@@ -203,6 +205,48 @@ class Skeleton:
             [f"{bone.name}_{c}" for bone in self.bones for c in bone.channels],
             dtype=object,
         )
+
+    def detect_up_axis(self, data=None, feature_names=None):
+        """The axis the body stands along in ``data`` (or in the rest pose).
+
+        Seen from the pelvis (the first bone where the skeleton branches), the
+        legs hang below and the spine rises above, while the legs sit side by
+        side: along the up axis the centroids of the pelvis's branches lie
+        farthest apart, in a T-pose as in a walk.  Each of up to 200 frames,
+        evenly spaced, votes for the axis along which they spread most (for a
+        skeleton that does not branch, the axis along which it is longest),
+        in the world frame of the data: a file whose root rotation stands a
+        y-up rest pose on the z axis is z-up.  This is the axis to give
+        Blender's BVH importer as *Up* (its default is Y).
+
+        The readers set :attr:`up_axis` with it: :func:`read_bvh` from the
+        motion (unless the file declares its axis), :meth:`from_bvh` and
+        :meth:`from_asf` from the rest pose, and :func:`read_amc` warns when
+        the motion stands along another axis than its skeleton's.
+
+        Parameters
+        ----------
+        data : array-like of shape (n_frames, n_features), default=None
+            Raw channels; None takes the rest pose (every channel 0).
+        feature_names : array-like of str, default=None
+            Names of the columns of ``data``; default
+            :attr:`feature_names`.
+
+        Returns
+        -------
+        up_axis : {"x", "y", "z"} or None
+            None when the poses cannot tell (every joint at one point, as in
+            the rest pose of a file whose joints are all placed by position
+            channels).
+
+        Examples
+        --------
+        >>> from sklearn_crbm.datasets import make_walker
+        >>> walker = make_walker(n_sequences=1, n_frames=20, random_state=0)
+        >>> walker.skeleton.detect_up_axis(walker.data)
+        'y'
+        """
+        return detect_up_axis(self, data, feature_names)
 
     # ------------------------------------------------------ forward kinematics
     def forward_kinematics(self, data, feature_names=None):
@@ -351,25 +395,33 @@ class Skeleton:
     def from_asf(cls, path):
         """Read an Acclaim ASF skeleton file (e.g. CMU ``35.asf``).
 
+        The up axis is detected from the rest pose (see
+        :meth:`detect_up_axis`); y where it cannot tell (the CMU axes).
+
         Raises
         ------
         ValueError
             If the file is malformed; the message names the file and line.
         """
-        return cls(**parse_asf(path))
+        return settle_up_axis(cls(**parse_asf(path)), path)
 
     @classmethod
     def from_bvh(cls, path):
         """Read the skeleton from the HIERARCHY of a BVH file.
 
         End sites become bones named ``"{parent}_end"`` without channels.
+        The up axis is the one the file declares (:func:`write_bvh` does),
+        else the one detected from the rest pose (see :meth:`detect_up_axis`),
+        else y.
 
         Raises
         ------
         ValueError
             If the file is malformed; the message names the file and line.
         """
-        return cls(**parse_bvh_hierarchy(path))
+        header, _ = split_header(path)
+        skeleton = cls(**parse_bvh_hierarchy(path, header))
+        return settle_up_axis(skeleton, path, declared_up_axis(header))
 
     @classmethod
     def from_mit(cls, skel, offsets=None):

@@ -170,9 +170,12 @@ def test_default_exponential_maps_do_not_flip_in_walks_and_runs(files):
 
 
 def test_a_wrong_up_axis_is_reported(files):
-    skeleton, data = files["pybvh/bvh_test3.bvh"]  # z up, read as y up
+    skeleton, data = files["pybvh/bvh_test3.bvh"]  # z up, and read as z up
+    assert skeleton.up_axis == "z"
     with pytest.warns(UserWarning, match="try up_axis='z'"):
-        make_motion_preprocessor(skeleton).fit(data)
+        with pytest.warns(UserWarning, match="sets up axis 'y', but the body"):
+            make_motion_preprocessor(skeleton, up_axis="y").fit(data)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        make_motion_preprocessor(skeleton).fit(data)
         make_motion_preprocessor(skeleton, up_axis="z").fit(data)

@@ -1,0 +1,182 @@
+"""The command line's commands and their arguments (see :mod:`._cli`)."""
+
+import tempfile
+from pathlib import Path
+
+from ._crbm import ConditionalRBM
+
+__all__ = ["COMMANDS", "DEMO_OUTPUT"]
+
+# The demo writes here unless --output says otherwise: never into the current
+# folder, which in a checkout is the repository.
+DEMO_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_demo"
+# The model options default to the estimator's own defaults.
+_DEFAULTS = ConditionalRBM()
+
+
+def _option(*flags, help, **settings):
+    """One argument of a command: its flags and ``add_argument``'s settings."""
+    return flags, dict(help=help, **settings)
+
+
+_DATA_HOME = _option(
+    "--data-home",
+    type=Path,
+    help="data folder (default: $SKLEARN_CRBM_DATA, else ~/sklearn_crbm_data)",
+)
+_N_FRAMES = _option(
+    "--n-frames", type=int, default=300, help="frames generated per sequence"
+)
+_MODEL_OPTIONS = [
+    _option("--n-components", type=int, default=200, help="hidden units of the CRBM"),
+    _option("--order", type=int, default=3, help="past frames each frame depends on"),
+    _option(
+        "--history-noise",
+        type=float,
+        default=_DEFAULTS.history_noise,
+        help="noise on the history during training (0 is the paper's schedule, "
+        "whose fill-ins and generated styles drift for some seeds)",
+    ),
+    _option(
+        "--history-noise-fraction",
+        type=float,
+        default=_DEFAULTS.history_noise_fraction,
+        help="share of each training frame's channels whose history gets the noise",
+    ),
+    _option(
+        "--average-fraction",
+        type=float,
+        default=_DEFAULTS.average_fraction,
+        help="final share of the epochs whose parameters are averaged (0: keep "
+        "the last epoch's, the paper's schedule)",
+    ),
+    _option(
+        "--n-iter", type=int, default=1000, help="training epochs (the paper: 4000)"
+    ),
+    _option("--seed", type=int, default=0, help="random seed of training and sampling"),
+]
+
+
+COMMANDS = {
+    "demo": (
+        "the paper's demo on CMU 35: train, fill in, generate, draw",
+        "Train a CRBM on CMU subject 35, print the fill-in table against "
+        "nearest neighbour, KNNImputer and the autoregressive imputer, "
+        "generate walking and jogging, and write figures and BVH/AMC files. "
+        "The defaults take a few minutes on 2 cores; --full runs the paper's "
+        "4000 epochs and 100 fill-in repeats.",
+        [
+            _DATA_HOME,
+            *_MODEL_OPTIONS,
+            _option(
+                "--output",
+                type=Path,
+                default=DEMO_OUTPUT,
+                help="folder for the figures and the generated motion (BVH and "
+                "AMC files)",
+            ),
+            _option(
+                "--n-repeats",
+                type=int,
+                default=20,
+                help="single-draw fills averaged per case (the paper: 100)",
+            ),
+            _option(
+                "--n-particles",
+                type=int,
+                default=20,
+                help="weighted particles per fill-in chain (1: the original scheme)",
+            ),
+            _N_FRAMES,
+            _option(
+                "--full",
+                action="store_true",
+                help="the paper's full size: 4000 epochs, 100 fill-in repeats",
+            ),
+            _option(
+                "--no-figures",
+                action="store_true",
+                help="skip the figures (the BVH and AMC files are still written)",
+            ),
+        ],
+    ),
+    "fetch": (
+        "download CMU 35 and the MIT walking data",
+        "Download CMU subject 35 (ASF/AMC, the paper's 33 walking and jogging "
+        "trials) and Taylor's MIT walking data into the data folder, checking "
+        "every file's SHA-256.",
+        [_DATA_HOME],
+    ),
+    "fit": (
+        "train preprocessing + CRBM on motion files and save it",
+        "Train the motion preprocessing and a ConditionalRBM on a folder of "
+        "BVH files or ASF/AMC files (each file one sequence, all of one "
+        "skeleton), or on CMU subject 35 when no folder is given, and save "
+        "them with joblib for the sample command. The file holds a dict: "
+        "'pipeline' (a fitted sklearn_crbm.preprocessing.MotionPipeline), "
+        "'seed_windows' (real frames of each style, CMU 35 only) and "
+        "'frame_rate'.",
+        [
+            _option(
+                "folder",
+                type=Path,
+                nargs="?",
+                help="a folder of *.bvh files, or of *.amc files with their *.asf "
+                "(default: CMU subject 35's training trials from --data-home)",
+            ),
+            _DATA_HOME,
+            _option(
+                "--frame-rate",
+                type=float,
+                default=30.0,
+                help="frames per second to train at; faster files drop frames "
+                "(AMC files are read as 120 frames/s, CMU's rate)",
+            ),
+            *_MODEL_OPTIONS,
+            _option(
+                "--output",
+                type=Path,
+                default=Path("crbm.joblib"),
+                help="file the fitted pipeline (preprocessing + CRBM) is saved to",
+            ),
+        ],
+    ),
+    "sample": (
+        "generate motion from a saved model and write BVH (and AMC) files",
+        "Generate motion from a model saved by the fit command and write one "
+        "BVH file per sequence, and an AMC file beside it when the model was "
+        "trained on ASF/AMC files. The seed frames are saved with the model: "
+        "no data is read.",
+        [
+            _option("model", type=Path, help="a file written by the fit command"),
+            _option(
+                "--style",
+                help="seed each sequence with real frames of this style ('walk' "
+                "or 'jog' for CMU 35); default: the model's own seed windows, "
+                "from every training sequence",
+            ),
+            _N_FRAMES,
+            _option("--n-sequences", type=int, default=1, help="sequences generated"),
+            _option(
+                "--hidden-noise",
+                type=float,
+                default=0.0,
+                help="noise on the hidden biases, for style transitions (paper "
+                "§4.3); measured on CMU 35: no walk-to-jog transition up to 2.0, "
+                "a few from 2.5, nearly every walk from 4.0",
+            ),
+            _option(
+                "--seed",
+                type=int,
+                default=0,
+                help="random seed of the seeds and sampling",
+            ),
+            _option(
+                "--output",
+                type=Path,
+                default=Path("generated"),
+                help="prefix of the files written (PREFIX_0.bvh, PREFIX_1.bvh, ...)",
+            ),
+        ],
+    ),
+}
