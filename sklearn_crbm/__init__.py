@@ -9,6 +9,8 @@ preprocessing, on-line filling in of missing channels, and generation.
 from . import datasets, metrics, model_selection, plotting, preprocessing
 from ._config import config_context, get_config, set_config
 from ._crbm import ConditionalRBM
+from ._factored import FactoredCRBM
+from ._labelled import LabelledCRBM
 from ._stacked import StackedCRBM
 from ._training import TrainingDivergedError
 from .impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
@@ -26,6 +28,8 @@ __all__ = [
     "CRBMImputer",
     "ConditionalRBM",
     "ExpMapEncoder",
+    "FactoredCRBM",
+    "LabelledCRBM",
     "NearestNeighborImputer",
     "RootRelativeEncoder",
     "StackedCRBM",

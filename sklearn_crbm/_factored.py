@@ -1,0 +1,269 @@
+"""Factored conditional RBM: one model of many styles (Taylor & Hinton, ICML 2009)."""
+
+from numbers import Integral, Real
+
+from sklearn.utils._param_validation import Interval
+
+from ._base import FittedParameter
+from ._factored_layer import FactoredLayer
+from ._style_model import BaseStyleModel
+
+__all__ = ["FactoredCRBM"]
+
+
+class FactoredCRBM(BaseStyleModel):
+    """Factored conditional RBM whose interactions are gated by style labels.
+
+    One model of motion in many styles (Taylor & Hinton, 2009).  Each
+    frame's label weights ``y`` (one-hot for a labelled frame) give style
+    features ``z = y R``, and every interaction of a conditional RBM (past
+    to visible, past to hidden, visible to hidden) goes through factors
+    that the style features gate, so that one set of weights learns what
+    the styles share and the gates what sets them apart.  Given its labels
+    (or a blend of them, frame by frame), the model generates, scores and
+    fills in motion of that style; given none, it names a sequence's style
+    by Bayes' rule.
+
+    Data are in long format as for :class:`ConditionalRBM`: ``X`` stacks
+    all sequences, ``sequence_ids`` marks which frames belong together, and
+    ``y`` gives every frame's style.  Standardise ``X`` first (the visible
+    units are Gaussian with unit variance).
+
+    Parameters
+    ----------
+    n_components : int, default=300
+        Number of binary hidden units.
+    n_factors : int, default=100
+        Number of factors of each kind (autoregressive, past-to-hidden,
+        undirected).
+    n_style_features : int, default=50
+        Number of real-valued style features ``z`` the labels map to.
+    order : int, default=6
+        Number of past frames feeding the visible and hidden units.
+    shared_style_weights : bool, default=True
+        One style-feature-to-factor matrix for the three kinds of factor
+        (the released code's default); False learns one per kind.
+    learning_rate : float, default=1e-2
+        Step size of the undirected, past-to-hidden and
+        style-feature-to-factor weights and the biases; the autoregressive
+        weights and the label-to-feature weights ``R`` take a tenth of it.
+    momentum : float, default=0.9
+        Momentum used after the first ``momentum_delay`` epochs.
+    momentum_delay : int, default=5
+        Number of epochs trained without momentum.
+    weight_decay : float, default=2e-4
+        L2 penalty on every weight (not on biases).
+    cd_steps : int, default=10
+        Reconstructions per update (CD-k).
+    batch_size : int, default=100
+        Frames per minibatch.
+    batching : {"balanced", "shuffled"}, default="shuffled"
+        ``"shuffled"``: all trainable frames shuffled each epoch;
+        ``"balanced"``: one frame of each consecutive chunk per minibatch
+        (see :class:`ConditionalRBM`).
+    history_noise : float, default=1.0
+        Standard deviation of Gaussian noise added to the past frames during
+        training (in the units of ``X``).
+    history_noise_fraction : float in (0, 1], default=1.0
+        Probability with which each channel of a frame's past gets the
+        noise.
+    average_fraction : float in [0, 1), default=0.0
+        :meth:`fit` keeps the mean of the parameters over the last
+        ``ceil(average_fraction * n_iter)`` epochs (0: the last epoch's).
+    n_iter : int, default=400
+        Number of epochs.
+    n_gibbs : int, default=100
+        Alternating Gibbs iterations per generated frame in :meth:`sample`.
+    priors : array-like of shape (n_classes,), default=None
+        Prior probabilities of the styles in :meth:`predict_proba`; None:
+        equal.
+    ais_steps : int, default=50
+        Intermediate distributions of the annealed importance sampling of
+        :meth:`score` and :meth:`score_samples`.
+    ais_chains : int, default=2
+        Annealing chains per frame.
+    early_stopping : bool, default=False
+        Hold out whole sequences (``validation_fraction``), score them
+        every ``validation_interval`` epochs and keep the best parameters
+        (see :class:`ConditionalRBM`).
+    validation_fraction : float, default=0.1
+    n_iter_no_change : int, default=50
+    validation_interval : int, default=10
+    tol : float, default=1e-3
+    random_state : int, RandomState instance or None, default=None
+        Controls initialisation, minibatches, sampling during training and,
+        unless given their own, generation and scoring.
+    verbose : int, default=0
+        Report training progress every ``verbose`` epochs.
+
+    Attributes
+    ----------
+    classes_ : ndarray of shape (n_classes,)
+        The styles, in the order of the columns of label weights.
+    visible_factors_ : ndarray of shape (n_features, n_factors)
+        ``W_v``: the visible units' weights to the undirected factors.
+    hidden_factors_ : ndarray of shape (n_components, n_factors)
+        ``W_h``: the hidden units' weights to the undirected factors.
+    past_visible_factors_ : ndarray of shape (order * n_features, n_factors)
+        ``P_A``: the past's weights to the autoregressive factors (lag-major
+        rows: ``x[t-1]`` first).
+    visible_from_factors_ : ndarray of shape (n_features, n_factors)
+        ``A_v``: the autoregressive factors' weights to the visible units.
+    past_hidden_factors_ : ndarray of shape (order * n_features, n_factors)
+        ``P_B``.
+    hidden_from_factors_ : ndarray of shape (n_components, n_factors)
+        ``B_h``.
+    label_features_ : ndarray of shape (n_classes, n_style_features)
+        ``R``: the style features of each label.
+    style_factors_ : ndarray of shape (n_style_features, n_factors)
+        ``Z``: the style features' weights to every kind of factor (with
+        ``shared_style_weights``; otherwise ``style_undirected_``,
+        ``style_hidden_`` and ``style_visible_``).
+    intercept_hidden_ : ndarray of shape (n_components,)
+    intercept_visible_ : ndarray of shape (n_features,)
+    seed_windows_ : ndarray of shape (n_windows, order, n_features)
+        Windows of training frames kept to seed :meth:`sample`.
+    reconstruction_error_ : float
+        Mean squared reconstruction error per frame of the last epoch.
+    n_iter_ : int
+        Epochs trained so far.
+    n_features_in_ : int
+        Number of features seen during :term:`fit`.
+    feature_names_in_ : ndarray of shape (`n_features_in_`,)
+        Names of features seen during :term:`fit`. Defined only when `X`
+        has feature names that are all strings.
+
+    See Also
+    --------
+    ConditionalRBM : One style, or styles modelled implicitly.
+
+    References
+    ----------
+    G. W. Taylor and G. E. Hinton. Factored Conditional Restricted Boltzmann
+    Machines for Modeling Motion Style. ICML 2009.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn_crbm import FactoredCRBM
+    >>> from sklearn_crbm.datasets import make_oscillations
+    >>> X, ids = make_oscillations(n_sequences=4, n_frames=60, random_state=0)
+    >>> styles = np.where(ids < 2, "slow", "fast")
+    >>> model = FactoredCRBM(16, n_factors=8, n_style_features=4, order=2,
+    ...                      cd_steps=1, n_iter=5, random_state=0)
+    >>> model = model.fit(X, styles, sequence_ids=ids)
+    >>> model.classes_
+    array(['fast', 'slow'], dtype='<U4')
+    >>> model.sample(20, style="slow", n_sequences=2, n_gibbs=5).shape
+    (40, 6)
+    >>> weights = np.linspace([1, 0], [0, 1], 20)  # from fast to slow
+    >>> model.sample(20, style=weights, n_gibbs=5).shape
+    (20, 6)
+    """
+
+    _parameter_constraints: dict = {
+        **{
+            name: constraint
+            for name, constraint in BaseStyleModel._parameter_constraints.items()
+            if name != "hidden_order"
+        },
+        "n_components": [Interval(Integral, 1, None, closed="left")],
+        "n_factors": [Interval(Integral, 1, None, closed="left")],
+        "n_style_features": [Interval(Integral, 1, None, closed="left")],
+        "shared_style_weights": ["boolean"],
+        "n_gibbs": [Interval(Integral, 0, None, closed="left")],
+        "learning_rate": [Interval(Real, 0, None, closed="neither")],
+    }
+
+    # A new frame's Gibbs chain starts at the previous frame plus this much
+    # noise, as in the released code.
+    _start_jitter = 0.05
+
+    visible_factors_ = FittedParameter("visible_factors")
+    hidden_factors_ = FittedParameter("hidden_factors")
+    past_visible_factors_ = FittedParameter("past_visible_factors")
+    visible_from_factors_ = FittedParameter("visible_from_factors")
+    past_hidden_factors_ = FittedParameter("past_hidden_factors")
+    hidden_from_factors_ = FittedParameter("hidden_from_factors")
+    label_features_ = FittedParameter("label_features")
+    style_factors_ = FittedParameter("style_factors")
+    style_undirected_ = FittedParameter("style_undirected")
+    style_hidden_ = FittedParameter("style_hidden")
+    style_visible_ = FittedParameter("style_visible")
+    intercept_hidden_ = FittedParameter("hidden_bias")
+    intercept_visible_ = FittedParameter("visible_bias")
+
+    def __init__(
+        self,
+        n_components=300,
+        *,
+        n_factors=100,
+        n_style_features=50,
+        order=6,
+        shared_style_weights=True,
+        learning_rate=1e-2,
+        momentum=0.9,
+        momentum_delay=5,
+        weight_decay=2e-4,
+        cd_steps=10,
+        batch_size=100,
+        batching="shuffled",
+        history_noise=1.0,
+        history_noise_fraction=1.0,
+        average_fraction=0.0,
+        n_iter=400,
+        n_gibbs=100,
+        priors=None,
+        ais_steps=50,
+        ais_chains=2,
+        early_stopping=False,
+        validation_fraction=0.1,
+        n_iter_no_change=50,
+        validation_interval=10,
+        tol=1e-3,
+        random_state=None,
+        verbose=0,
+    ):
+        self.n_components = n_components
+        self.n_factors = n_factors
+        self.n_style_features = n_style_features
+        self.order = order
+        self.shared_style_weights = shared_style_weights
+        self.learning_rate = learning_rate
+        self.momentum = momentum
+        self.momentum_delay = momentum_delay
+        self.weight_decay = weight_decay
+        self.cd_steps = cd_steps
+        self.batch_size = batch_size
+        self.batching = batching
+        self.history_noise = history_noise
+        self.history_noise_fraction = history_noise_fraction
+        self.average_fraction = average_fraction
+        self.n_iter = n_iter
+        self.n_gibbs = n_gibbs
+        self.priors = priors
+        self.ais_steps = ais_steps
+        self.ais_chains = ais_chains
+        self.early_stopping = early_stopping
+        self.validation_fraction = validation_fraction
+        self.n_iter_no_change = n_iter_no_change
+        self.validation_interval = validation_interval
+        self.tol = tol
+        self.random_state = random_state
+        self.verbose = verbose
+
+    @property
+    def _hidden_order(self):
+        return self.order
+
+    def _new_layer(self, n_features, dtype):
+        return FactoredLayer(
+            n_features,
+            self.n_components,
+            self.n_factors,
+            self.n_style_features,
+            len(self.classes_),
+            self.order,
+            dtype,
+            shared_style_weights=self.shared_style_weights,
+        )

@@ -1,0 +1,242 @@
+"""A conditional RBM whose dynamic biases also take the style labels (no gating)."""
+
+from numbers import Integral, Real
+
+from sklearn.utils._param_validation import Interval, StrOptions
+
+from ._base import FittedParameter
+from ._crbm_layer import CRBM_GROUPS, CRBMLayer
+from ._parameters import ParameterGroup, small_normal
+from ._style_model import BaseStyleModel
+
+__all__ = ["LabelledCRBM"]
+
+LABELLED_GROUPS = CRBM_GROUPS + (
+    ParameterGroup(
+        "label_weights",
+        lambda p: (p.n_features + p.n_components, p.n_classes),
+        lambda p, rng: small_normal(rng, p.label_weights.shape, p.dtype),
+        decayed=True,
+    ),
+)
+
+
+class LabelledLayer(CRBMLayer):
+    """A CRBM layer whose dynamic biases add ``L y``, ``y`` the frame's label weights.
+
+    ``label_weights`` (n_features + n_components, n_classes) stacks the
+    label-to-visible rows over the label-to-hidden rows, as ``dynamic``
+    stacks the autoregressive weights over the past-to-hidden ones.
+    """
+
+    groups = LABELLED_GROUPS
+
+    def __init__(self, n_features, n_components, n_classes, order, hidden_order, dtype):
+        self.n_classes = n_classes
+        super().__init__(
+            n_features, n_components, order, hidden_order, "gaussian", dtype
+        )
+
+    @property
+    def label_to_visible(self):
+        return self.label_weights[: self.n_features]
+
+    @property
+    def label_to_hidden(self):
+        return self.label_weights[self.n_features :]
+
+    def frame_rbms(self, history, context=None, *, out=None):
+        rbms = super().frame_rbms(history, out=out)
+        labelled = self.ops.matmul(context, self.label_weights.T)
+        rbms.visible_bias += labelled[:, : self.n_features]
+        rbms.hidden_bias += labelled[:, self.n_features :]
+        return rbms
+
+    def conditioner(self):
+        return self.frame_rbms
+
+    def cd_statistics(self, visible, history, context, *args, out, workspace, **kw):
+        out, error = super().cd_statistics(
+            visible, history, context, *args, out=out, workspace=workspace, **kw
+        )
+        # [v - v_recon, h_data - h_recon], scaled: the labels' statistics, as
+        # the directed weights' are those of the history
+        delta = workspace.delta[: visible.shape[0], ...]
+        out.label_weights[...] = self.ops.matmul(delta.T, context)
+        return out, error
+
+
+class LabelledCRBM(BaseStyleModel):
+    """Conditional RBM whose dynamic biases also take each frame's style label.
+
+    The simplest model of a labelled corpus: a :class:`ConditionalRBM`
+    whose visible and hidden units get, besides their inputs from the
+    past, an input from the frame's label weights ``y`` (one-hot for a
+    labelled frame): ``c_hat = c + A x_past + L_v y`` and ``b_hat = b + B
+    x_past + L_h y``.  The labels shift the biases but do not change how
+    the units interact (no gating): the baseline Taylor & Hinton (2009)
+    compare :class:`FactoredCRBM` with.  It generates, scores, fills in
+    and names styles as :class:`FactoredCRBM` does.
+
+    Parameters
+    ----------
+    n_components : int, default=200
+        Number of binary hidden units.
+    order : int, default=3
+        Number of past frames feeding the visible units.
+    hidden_order : int, default=None
+        Number of past frames feeding the hidden units; None means ``order``.
+    learning_rate : float, default=1e-3
+    momentum : float, default=0.9
+    momentum_delay : int, default=5
+    weight_decay : float, default=2e-4
+    cd_steps : int, default=1
+    batch_size : int, default=100
+    batching : {"balanced", "shuffled"}, default="balanced"
+    history_noise : float, default=1.0
+    history_noise_fraction : float in (0, 1], default=0.5
+    average_fraction : float in [0, 1), default=0.25
+    n_iter : int, default=1000
+    n_gibbs : int, default=30
+        Alternating Gibbs iterations per generated frame in :meth:`sample`.
+    priors : array-like of shape (n_classes,), default=None
+        Prior probabilities of the styles in :meth:`predict_proba`.
+    ais_steps : int, default=50
+    ais_chains : int, default=2
+    early_stopping : bool, default=False
+    validation_fraction : float, default=0.1
+    n_iter_no_change : int, default=50
+    validation_interval : int, default=10
+    tol : float, default=1e-3
+    random_state : int, RandomState instance or None, default=None
+    verbose : int, default=0
+        The parameters without a description are those of
+        :class:`ConditionalRBM`, with its defaults.
+
+    Attributes
+    ----------
+    classes_ : ndarray of shape (n_classes,)
+        The styles, in the order of the columns of label weights.
+    components_ : ndarray of shape (n_components, n_features)
+    intercept_hidden_ : ndarray of shape (n_components,)
+    intercept_visible_ : ndarray of shape (n_features,)
+    autoregressive_ : ndarray of shape (order, n_features, n_features)
+    past_to_hidden_ : ndarray of shape (hidden_order, n_components, n_features)
+    label_to_visible_ : ndarray of shape (n_features, n_classes)
+        ``L_v``: what each style adds to the visible biases.
+    label_to_hidden_ : ndarray of shape (n_components, n_classes)
+        ``L_h``: what each style adds to the hidden biases.
+    seed_windows_ : ndarray of shape (n_windows, width, n_features)
+    reconstruction_error_ : float
+    n_iter_ : int
+    n_features_in_ : int
+        Number of features seen during :term:`fit`.
+    feature_names_in_ : ndarray of shape (`n_features_in_`,)
+        Names of features seen during :term:`fit`. Defined only when `X`
+        has feature names that are all strings.
+
+    See Also
+    --------
+    FactoredCRBM : The labels gate every interaction.
+    ConditionalRBM : No labels.
+
+    References
+    ----------
+    G. W. Taylor and G. E. Hinton. Factored Conditional Restricted Boltzmann
+    Machines for Modeling Motion Style. ICML 2009.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn_crbm import LabelledCRBM
+    >>> from sklearn_crbm.datasets import make_oscillations
+    >>> X, ids = make_oscillations(n_sequences=4, n_frames=60, random_state=0)
+    >>> styles = np.where(ids < 2, "slow", "fast")
+    >>> model = LabelledCRBM(16, order=2, n_iter=10, random_state=0)
+    >>> model = model.fit(X, styles, sequence_ids=ids)
+    >>> model.label_to_hidden_.shape
+    (16, 2)
+    >>> model.sample(20, style="fast", n_sequences=2).shape
+    (40, 6)
+    """
+
+    _parameter_constraints: dict = {
+        **BaseStyleModel._parameter_constraints,
+        "n_components": [Interval(Integral, 1, None, closed="left")],
+        "n_gibbs": [Interval(Integral, 0, None, closed="left")],
+        "batching": [StrOptions({"balanced", "shuffled"})],
+        "learning_rate": [Interval(Real, 0, None, closed="neither")],
+    }
+
+    components_ = FittedParameter("weights")
+    intercept_hidden_ = FittedParameter("hidden_bias")
+    intercept_visible_ = FittedParameter("visible_bias")
+    autoregressive_ = FittedParameter("autoregressive")
+    past_to_hidden_ = FittedParameter("past_to_hidden")
+    label_to_visible_ = FittedParameter("label_to_visible")
+    label_to_hidden_ = FittedParameter("label_to_hidden")
+
+    def __init__(
+        self,
+        n_components=200,
+        *,
+        order=3,
+        hidden_order=None,
+        learning_rate=1e-3,
+        momentum=0.9,
+        momentum_delay=5,
+        weight_decay=2e-4,
+        cd_steps=1,
+        batch_size=100,
+        batching="balanced",
+        history_noise=1.0,
+        history_noise_fraction=0.5,
+        average_fraction=0.25,
+        n_iter=1000,
+        n_gibbs=30,
+        priors=None,
+        ais_steps=50,
+        ais_chains=2,
+        early_stopping=False,
+        validation_fraction=0.1,
+        n_iter_no_change=50,
+        validation_interval=10,
+        tol=1e-3,
+        random_state=None,
+        verbose=0,
+    ):
+        self.n_components = n_components
+        self.order = order
+        self.hidden_order = hidden_order
+        self.learning_rate = learning_rate
+        self.momentum = momentum
+        self.momentum_delay = momentum_delay
+        self.weight_decay = weight_decay
+        self.cd_steps = cd_steps
+        self.batch_size = batch_size
+        self.batching = batching
+        self.history_noise = history_noise
+        self.history_noise_fraction = history_noise_fraction
+        self.average_fraction = average_fraction
+        self.n_iter = n_iter
+        self.n_gibbs = n_gibbs
+        self.priors = priors
+        self.ais_steps = ais_steps
+        self.ais_chains = ais_chains
+        self.early_stopping = early_stopping
+        self.validation_fraction = validation_fraction
+        self.n_iter_no_change = n_iter_no_change
+        self.validation_interval = validation_interval
+        self.tol = tol
+        self.random_state = random_state
+        self.verbose = verbose
+
+    def _new_layer(self, n_features, dtype):
+        return LabelledLayer(
+            n_features,
+            self.n_components,
+            len(self.classes_),
+            self.order,
+            self._hidden_order,
+            dtype,
+        )

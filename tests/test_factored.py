@@ -1,0 +1,299 @@
+"""Tests of FactoredCRBM: the style-gated factored CRBM (Taylor & Hinton, 2009)."""
+
+import itertools
+import pickle
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose, assert_array_equal
+from scipy.special import logsumexp
+
+from sklearn_crbm import CRBMImputer, FactoredCRBM
+from sklearn_crbm.datasets import make_styled_oscillations
+
+
+def styled_data(random_state=0, switching=True, n_sequences=8):
+    return make_styled_oscillations(
+        n_sequences, switching=switching, random_state=random_state
+    )
+
+
+def small_model(**params):
+    defaults = dict(
+        n_components=8,
+        n_factors=6,
+        n_style_features=3,
+        order=2,
+        cd_steps=1,
+        learning_rate=0.1,
+        n_iter=200,
+        n_gibbs=20,
+        random_state=0,
+    )
+    return FactoredCRBM(**{**defaults, **params})
+
+
+@pytest.fixture(scope="module")
+def fitted():
+    X, ids, styles = styled_data()
+    return small_model().fit(X, styles, sequence_ids=ids)
+
+
+def test_fit_learns_the_styles(fitted):
+    assert_array_equal(fitted.classes_, ["high", "low"])
+    assert fitted.n_iter_ == 200 and fitted._layer.is_finite()
+    X, ids, styles = styled_data(random_state=1)
+    flipped = np.where(styles == "low", "high", "low")
+    right = fitted.predict_next(X, styles, sequence_ids=ids)
+    wrong = fitted.predict_next(X, flipped, sequence_ids=ids)
+    assert np.mean((X - right)[:, 0] ** 2) < 0.25 * np.mean((X - wrong)[:, 0] ** 2)
+    assert fitted.score(X, styles, sequence_ids=ids) > fitted.score(
+        X, flipped, sequence_ids=ids
+    )
+
+
+def test_fitted_attributes_view_the_layer(fitted):
+    layer = fitted._layer
+    assert fitted.visible_factors_.shape == (6, 6)
+    assert fitted.hidden_factors_.shape == (8, 6)
+    assert fitted.past_visible_factors_.shape == (12, 6)
+    assert fitted.label_features_.shape == (2, 3)
+    assert fitted.style_factors_.shape == (3, 6)
+    assert np.shares_memory(fitted.hidden_factors_, layer.flat)
+    assert not hasattr(fitted, "style_hidden_")  # shared: one matrix
+    separate = small_model(shared_style_weights=False, n_iter=2)
+    X, ids, styles = styled_data()
+    separate.fit(X, styles, sequence_ids=ids)
+    assert separate.style_hidden_.shape == (3, 6)
+    assert separate._layer.flat.size > fitted._layer.flat.size
+
+
+def test_labels_of_any_kind_and_label_weights():
+    X, ids, styles = styled_data()
+    codes = np.where(styles == "high", 7, 3)
+    model = small_model(n_iter=2).fit(X, codes, sequence_ids=ids)
+    assert_array_equal(model.classes_, [3, 7])
+    weights = np.stack([styles == "high", styles == "low"], axis=1).astype(float)
+    model = small_model(n_iter=2).fit(X, weights, sequence_ids=ids)
+    assert_array_equal(model.classes_, [0, 1])
+    assert model.sample(5, style=1, n_gibbs=2).shape == (5, 6)
+
+
+def exact_log_likelihood(model, X, ids, weights):
+    """``log p(x_t | past, y_t)`` from the energy, summed over every ``h``."""
+    layer = model._layer
+    d, order = layer.n_features, layer.order
+    states = np.array(list(itertools.product([0, 1], repeat=layer.n_components)))
+    result = []
+    for t in range(len(X)):
+        start = np.flatnonzero(ids == ids[t])[0]
+        p = np.concatenate([X[max(t - q, start)] for q in range(1, order + 1)])
+        z = weights[t] @ layer.label_features
+        g = z @ layer.style_factors
+        c_hat = layer.visible_bias + layer.visible_from_factors @ (
+            (p @ layer.past_visible_factors) * g
+        )
+        b_hat = layer.hidden_bias + layer.hidden_from_factors @ (
+            (p @ layer.past_hidden_factors) * g
+        )
+        # W_t = W_h diag(g) W_v.T; u = W_t.T h for every h
+        u = (states @ layer.hidden_factors * g) @ layer.visible_factors.T
+        v = X[t]
+        joint = -0.5 * np.sum((v - c_hat - u) ** 2, axis=1) + states @ b_hat
+        joint += u @ c_hat + 0.5 * np.sum(u**2, axis=1)
+        log_z = logsumexp(states @ b_hat + u @ c_hat + 0.5 * np.sum(u**2, axis=1))
+        result.append(logsumexp(joint) - log_z - 0.5 * d * np.log(2 * np.pi))
+    return np.array(result)
+
+
+def test_score_samples_is_exact_for_a_tiny_model():
+    X, ids, styles = styled_data(n_sequences=2)
+    model = small_model(n_components=5, n_iter=3).fit(X, styles, sequence_ids=ids)
+    rng = np.random.default_rng(0)
+    layer = model._layer
+    layer.flat[...] = 0.5 * rng.standard_normal(layer.flat.shape)
+    weights = rng.dirichlet([1, 1], size=len(X))  # blends, frame by frame
+    expected = exact_log_likelihood(model, X, ids, weights)
+    assert_allclose(model.score_samples(X, weights, sequence_ids=ids), expected)
+    one_hot = np.eye(2)[np.searchsorted(model.classes_, styles)]
+    assert_allclose(
+        model.score_samples(X, styles, sequence_ids=ids),
+        exact_log_likelihood(model, X, ids, one_hot),
+    )
+    # annealing agrees with enumeration to within its error
+    annealed = FactoredCRBM(**{**model.get_params(), "ais_steps": 500})
+    annealed.__dict__.update({k: v for k, v in vars(model).items() if k.endswith("_")})
+    annealed._layer = layer
+    result = annealed._log_likelihood(
+        X, _sequences(ids), method="ais", context=np.asarray(weights)
+    )
+    assert abs(result.log_likelihood.mean() - expected.mean()) < 0.05
+
+
+def _sequences(ids):
+    from sklearn_crbm.utils import check_sequence_ids
+
+    return check_sequence_ids(ids, len(ids))
+
+
+def test_predict_names_each_sequences_style(fitted):
+    X, ids, styles = styled_data(random_state=2, switching=False)
+    proba = fitted.predict_proba(X, sequence_ids=ids)
+    assert proba.shape == (len(X), 2)
+    assert_allclose(proba.sum(axis=1), 1)
+    assert_array_equal(fitted.predict(X, sequence_ids=ids), styles)
+    # every frame of a sequence gets its sequence's posterior
+    for sequence in np.unique(ids):
+        rows = proba[ids == sequence]
+        assert_allclose(rows, np.broadcast_to(rows[0], rows.shape))
+    skewed = FactoredCRBM(**{**fitted.get_params(), "priors": [1.0, 0.0]})
+    skewed.__dict__.update(
+        {k: v for k, v in vars(fitted).items() if k not in ("priors",)}
+    )
+    assert_array_equal(skewed.predict(X, sequence_ids=ids), "high")
+
+
+def test_sample_a_style_a_blend_and_a_transition(fitted):
+    X, ids, styles = styled_data()
+    seed = X[:5]
+    high = fitted.sample(60, history=seed, style="high", random_state=0)
+    low = fitted.sample(60, history=seed, style="low", random_state=0)
+    assert high[:, 0].mean() > 0.5 and low[:, 0].mean() < -0.5
+    transition = np.repeat([[0.0, 1.0], [1.0, 0.0]], 30, axis=0)  # low, then high
+    frames = fitted.sample(60, history=seed, style=transition, random_state=0)
+    assert frames[5:30, 0].mean() < -0.5 and frames[35:, 0].mean() > 0.5
+    blend = fitted.sample(
+        60, history=seed, style=np.full((60, 2), 0.5), n_sequences=3, random_state=0
+    )
+    assert blend.shape == (180, 6) and np.all(np.isfinite(blend))
+    again = fitted.sample(60, history=seed, style="high", random_state=0)
+    assert_array_equal(again, high)
+
+
+@pytest.mark.parametrize(
+    "style, message",
+    [
+        ("medium", "not seen in fit"),
+        (np.full((10, 2), -0.5), "non-negative"),
+        (np.full((10, 2), 0.4), "sum to 1"),
+        (np.full((10, 3), 1 / 3), r"shape \(n_frames, 2\)"),
+        (np.full((9, 2), 0.5), "9 frames' styles but 10"),
+        (np.array([[np.nan, 1.0]] * 10), "NaN"),
+    ],
+)
+def test_bad_styles_at_sample_are_clear_errors(fitted, style, message):
+    with pytest.raises(ValueError, match=message):
+        fitted.sample(10, style=style)
+
+
+def test_bad_labels_at_fit_and_short_history_are_clear_errors(fitted):
+    X, ids, styles = styled_data()
+    with pytest.raises(ValueError, match="requires y"):
+        small_model().fit(X, sequence_ids=ids)
+    with pytest.raises(ValueError, match="one style label per frame"):
+        small_model().fit(X, styles[:-1], sequence_ids=ids)
+    labels = np.where(styles == "high", 1.0, 0.0)
+    labels[3] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        small_model().fit(X, labels, sequence_ids=ids)
+    with pytest.raises(ValueError, match="at least 2 frames"):
+        fitted.sample(5, history=X[:1], style="high")
+    with pytest.raises(ValueError, match="not seen in fit"):
+        fitted.score(X, np.where(styles == "high", "x", "low"), sequence_ids=ids)
+
+
+def test_same_random_state_same_model_and_pickle_round_trip():
+    X, ids, styles = styled_data()
+    one = small_model(n_iter=5).fit(X, styles, sequence_ids=ids)
+    two = small_model(n_iter=5).fit(X, styles, sequence_ids=ids)
+    assert_array_equal(one._layer.flat, two._layer.flat)
+    loaded = pickle.loads(pickle.dumps(one))
+    assert_array_equal(
+        loaded.sample(10, style="low", random_state=1),
+        one.sample(10, style="low", random_state=1),
+    )
+
+
+def test_partial_fit_and_float32(fitted):
+    X, ids, styles = styled_data()
+    model = small_model()
+    for _ in range(3):
+        model.partial_fit(X.astype(np.float32), styles, sequence_ids=ids)
+    assert model.n_iter_ == 3
+    assert model.hidden_factors_.dtype == np.float32
+    assert model.sample(5, style="low", n_gibbs=2).dtype == np.float32
+    with pytest.raises(ValueError, match="not seen in fit"):
+        model.partial_fit(X, np.full(len(X), "other"), sequence_ids=ids)
+
+
+def test_imputer_fills_in_with_the_style_given_or_inferred(fitted):
+    X_train, ids_train, styles_train = styled_data()
+    X, ids, styles = styled_data(random_state=1, switching=False)
+    one = ids == 1  # a "high" sequence
+    X_missing = X[one].copy()
+    X_missing[30:, 0] = np.nan
+    imputer = CRBMImputer(
+        fitted, n_particles=10, offset_shrinkage=None, random_state=0
+    ).fit(X_train, styles_train, sequence_ids=ids_train)
+    errors = {}
+    for style in ("high", "low", None):
+        filled = imputer.transform(X_missing, style=style)
+        assert_array_equal(filled[:, 1:], X[one][:, 1:])
+        errors[style] = np.mean((filled[30:, 0] - X[one][30:, 0]) ** 2)
+    assert errors["high"] < 0.1 * errors["low"]
+    assert errors[None] < 0.1 * errors["low"]
+    with pytest.raises(ValueError, match="needs y"):
+        CRBMImputer(fitted).fit(X_train, sequence_ids=ids_train)
+
+
+class _MeanField:
+    """A stand-in for the hidden sampler: probabilities instead of states."""
+
+    def __init__(self, rbms):
+        self.rbms = rbms
+
+    def __call__(self, visible, rng, out, work, **_):
+        return self.rbms.hidden_probabilities(visible, out=out)
+
+
+@pytest.mark.parametrize("shared", [True, False])
+def test_cd_statistics_are_the_gradient_of_the_free_energy_difference(
+    monkeypatch, shared
+):
+    """With probabilities for states, CD-1's statistics are the gradient of
+    ``-F(v) + F(v_recon)`` (the reconstruction held fixed)."""
+    from sklearn_crbm import _factored_layer
+    from sklearn_crbm._factored_layer import FactoredLayer
+
+    monkeypatch.setattr(_factored_layer, "HiddenSampler", _MeanField)
+    rng = np.random.default_rng(0)
+    layer = FactoredLayer(3, 4, 5, 2, 3, 2, np.float64, shared_style_weights=shared)
+    layer.flat[...] = 0.5 * rng.standard_normal(layer.flat.shape)
+    visible = rng.standard_normal((6, 3))
+    history = rng.standard_normal((6, 6))
+    context = rng.dirichlet([1, 1, 1], size=6)
+    workspace = layer.new_workspace(6)
+    out = layer.zeros_like()
+    layer.cd_statistics(
+        visible, history, context, 1, rng, out=out, scale=1.0, workspace=workspace
+    )
+    reconstruction = workspace.reconstruction.copy()
+
+    def objective(flat):
+        trial = layer.copy()
+        trial.flat[...] = flat
+        rbms = trial.frame_rbms(history, context)
+        return np.sum(
+            rbms.negative_free_energy(visible)
+            - rbms.negative_free_energy(reconstruction)
+        )
+
+    step = 1e-6
+    numeric = np.array(
+        [
+            (objective(layer.flat + step * e) - objective(layer.flat - step * e))
+            / (2 * step)
+            for e in np.eye(layer.flat.size)
+        ]
+    )
+    assert_allclose(out.flat, numeric, rtol=1e-5, atol=1e-6)
