@@ -508,17 +508,25 @@ def _fill(
         # evidence; otherwise only frames to draw tell particles apart
         weighed = drawn if chain_context is None else lengths > step
         if n_particles > 1 and weighed.any():
+            some = _Some(ops, weighed, n_chains)
             chains = _ancestors(
-                history, context, frames, ~frame_missing, n_particles, rng
+                some.stack(history.frame_rbms(context)),
+                some.frames(frames),
+                some.frames(~frame_missing),
+                n_particles,
+                rng,
             )
-            chains = ops.where(ops.asarray(weighed)[None, :], chains, identity)
+            chains = some.put_back(chains, ops.broadcast_to(identity, shape[:2]))
             history.reorder(chains)
             if offsets is not None:
                 offsets.reorder(chains)
         stack = history.frame_rbms(context)
         prediction = None
         if offsets is not None or amplify:
-            prediction = _one_step_predictions(stack, shape)
+            alive = _Some(ops, lengths > step, n_chains)
+            prediction = stacked_prediction(alive.stack(stack), PREDICTION_STEPS)
+            prediction = ops.reshape(prediction, (n_chains, -1, shape[-1]))
+            prediction = alive.put_back(prediction, current)
         if offsets is not None and step >= layers[0].n_lags:
             offsets.update(prediction, frames, ~frame_missing)
         if drawn.any():
@@ -530,7 +538,9 @@ def _fill(
                 start = start + start_jitter * rng.standard_normal(
                     start.shape, start.dtype
                 )
-            current = draw(start, stack, clamp)[0]
+            some = _Some(ops, drawn, n_chains)
+            new = draw(some.take(start), some.stack(stack), some.take(clamp))[0]
+            current = some.put_back(new, current)
             if amplify:
                 current = ops.where(frame_missing, current, frames)
             if offsets is not None:
@@ -539,20 +549,66 @@ def _fill(
         history.push([current], stack)
 
 
-def _ancestors(history, context, frames, observed, n_particles, rng):
+class _Some:
+    """The sequences of a step that need work: gathered, worked on, put back.
+
+    A block of sequences of different lengths, or with frames to fill at
+    different steps, works on those that need it only.  Gathers alone, no
+    scatter (which the array API lacks): the results go back among the
+    others' values by one more gather.
+
+    Parameters
+    ----------
+    ops : module or ArrayOps
+    mask : ndarray of bool of shape (n_sequences,)
+        The sequences that need work (numpy).
+    n_chains : int
+    """
+
+    def __init__(self, ops, mask, n_chains):
+        self._ops = ops
+        self.every = bool(mask.all())
+        self.which = np.flatnonzero(mask)
+        n_sequences = len(mask)
+        # chain-major rows of the frame RBMs, as History.frame_rbms has them
+        self._rows = (np.arange(n_chains)[:, None] * n_sequences + self.which).ravel()
+        # sequence s is column where[s] of [the gathered values | the others']
+        self._where = np.arange(len(self.which), len(self.which) + n_sequences)
+        self._where[self.which] = np.arange(len(self.which))
+
+    def stack(self, stack):
+        """The frame RBMs of the sequences that need work."""
+        return stack if self.every else [rbms.take(self._rows) for rbms in stack]
+
+    def take(self, array):
+        """Their part of an array of shape ``(n_chains, n_sequences, ...)``."""
+        return array if self.every else self._ops.take(array, self.which, axis=1)
+
+    def frames(self, array):
+        """Their part of an array of shape ``(n_sequences, ...)``."""
+        return array if self.every else self._ops.take(array, self.which, axis=0)
+
+    def put_back(self, values, others):
+        """``values`` (theirs) among ``others`` (everyone's), along axis 1."""
+        if self.every:
+            return values
+        ops = self._ops
+        return ops.take(ops.concatenate((values, others), axis=1), self._where, axis=1)
+
+
+def _ancestors(stack, frames, observed, n_particles, rng):
     """Resample each group of particles by how well they explain the observed data.
 
     A particle's weight is the likelihood of the frame's observed channels
-    under its own one-step prediction
+    under its own one-step prediction from ``stack``, its frame RBMs
     (:func:`~sklearn_crbm._gibbs.observed_log_likelihood`); each group is
     resampled (systematic resampling).  Returns the ancestors, of shape
     ``(n_chains, n_sequences)``, as :meth:`History.reorder` takes them.
     """
-    ops = history.layers[0].ops
-    n_chains = history.shape[0]
-    n_groups = n_chains // n_particles
+    ops = stack[0].ops
     n_sequences, n_features = frames.shape
-    stack = history.frame_rbms(context)
+    n_chains = stack[0].n_frames // n_sequences
+    n_groups = n_chains // n_particles
     prediction = stacked_prediction(stack, PREDICTION_STEPS)
     log_weights = observed_log_likelihood(
         stack[0],
@@ -588,17 +644,6 @@ def _take_chains(ops, array, chains):
     flat = ops.reshape(array, (n_chains * n_sequences, -1))
     index = chains * n_sequences + ops.arange(n_sequences, dtype=ops.int64)
     return ops.reshape(ops.take(flat, ops.reshape(index, (-1,)), axis=0), array.shape)
-
-
-def _one_step_predictions(stack, shape):
-    """Every chain's mean-field prediction of the next frame from its past.
-
-    ``stack`` from :meth:`History.frame_rbms`; returns ``shape``, that is
-    ``(n_chains, n_sequences, n_features)``
-    (:func:`~sklearn_crbm._gibbs.stacked_prediction`).
-    """
-    prediction = stacked_prediction(stack, PREDICTION_STEPS)
-    return stack[0].ops.reshape(prediction, shape)
 
 
 def _amplifies(gain):

@@ -469,8 +469,7 @@ def test_particle_resampling_is_numpy_s_given_the_same_draws(
     for estimator, to in ((model, np.asarray), (moved, partial(_to, xp, device))):
         history = History.from_frames(estimator._layers(), to(past))
         chains = _ancestors(
-            history,
-            None,
+            history.frame_rbms(),
             to(frames),
             to(observed),
             n_particles,
