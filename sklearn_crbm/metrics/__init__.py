@@ -1,4 +1,4 @@
-"""Metrics for motion: the paper's fill-in error and generated-motion statistics."""
+"""Metrics for motion: the paper's fill-in error, generated-motion statistics, style."""
 
 from ._fillin import fillin_angle_rmse, fillin_error
 from ._generation import (
@@ -9,8 +9,10 @@ from ._generation import (
     spectral_similarity,
     step_frequency,
 )
+from ._style import StyleJudge
 
 __all__ = [
+    "StyleJudge",
     "fillin_angle_rmse",
     "fillin_error",
     "forward_speed",
