@@ -6,12 +6,14 @@ from pathlib import Path
 import numpy as np
 from sklearn.utils import Bunch
 
+from ._bandai import BANDAI_FOLDER
+from ._folders import read_bvh_folder
 from ._frame_rate import kept_frames
 from ._mit import load_mit_mat
 from ._parsing import load_mat_variables
 from ._skeleton import Skeleton
 
-__all__ = ["get_data_home", "load_cmu35", "load_mit_walk"]
+__all__ = ["get_data_home", "load_bandai_walks", "load_cmu35", "load_mit_walk"]
 
 DATA_HOME_ENV = "SKLEARN_CRBM_DATA"
 FRAME_RATE = 30.0
@@ -253,6 +255,75 @@ def load_mit_walk(data_home=None):
     )
 
 
+def load_bandai_walks(data_home=None):
+    """Bandai Namco walks in seven styles, with the style of every frame.
+
+    The content *walk* of the second set of the Bandai Namco Research Motion
+    dataset (Kobayashi et al., 2023): one actor walking in the styles
+    active, elderly, exhausted, feminine, masculine, normal and youthful,
+    takes 001-006 of each (42 takes, 11,337 frames at 30 frames per second),
+    read with :func:`read_bvh_folder` and the label of each take from its
+    JSON file and ``style_label.txt``.  The skeleton has a static
+    ``joint_Root`` above the moving ``Hips``, and position and rotation
+    channels on every joint (Y up, centimetres); the default
+    :func:`~sklearn_crbm.preprocessing.make_motion_preprocessor` encodes it
+    with an exact inverse.
+
+    Needs the folder ``bandai_walk_styles/`` in ``data_home`` (see
+    :func:`fetch_bandai_walks`).
+
+    Parameters
+    ----------
+    data_home : path-like, default=None
+        See :func:`get_data_home`.
+
+    Returns
+    -------
+    data : :class:`~sklearn.utils.Bunch`
+        data : ndarray of shape (11337, 132)
+            Raw BVH channels.
+        sequence_ids : ndarray of shape (n_frames,)
+            Index into ``sequence_names`` of every frame.
+        sequence_names : ndarray of str
+            Take names such as ``"dataset-2_walk_active_001"``.
+        takes : ndarray of shape (n_sequences,)
+            The take number of every sequence (1 to 6).
+        target : ndarray of shape (n_frames,)
+            The style of every frame, an index into ``target_names``.
+        target_names : ndarray of str
+            ``"active"``, ``"elderly"``, ``"exhausted"``, ``"feminine"``,
+            ``"masculine"``, ``"normal"``, ``"youthful"``.
+        feature_names, skeleton, skeletons, frame_rate, filenames
+            As :func:`read_bvh_folder` with ``labels="style"`` gives them.
+        DESCR : str
+            Description, licence and citation.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the data are not in ``data_home``; the message tells how to fetch them.
+
+    Examples
+    --------
+    >>> from sklearn_crbm.datasets import load_bandai_walks
+    >>> walks = load_bandai_walks()  # doctest: +SKIP
+    >>> walks.data.shape, list(walks.target_names[:2])  # doctest: +SKIP
+    ((11337, 132), ['active', 'elderly'])
+    """
+    names = _data_file(
+        data_home, BANDAI_FOLDER, "style_label.txt", "fetch_bandai_walks"
+    )
+    walks = read_bvh_folder(
+        names.parent, pattern="*_walk_*.bvh", frame_rate=FRAME_RATE, labels="style"
+    )
+    walks.target_names = np.array(
+        [name.removeprefix("dataset-2_") for name in walks.target_names], dtype=object
+    )
+    walks.takes = np.array([int(name[-3:]) for name in walks.sequence_names])
+    walks.DESCR = BANDAI_DESCR
+    return walks
+
+
 CMU35_DESCR = """\
 CMU subject 35: walking and jogging
 -----------------------------------
@@ -300,4 +371,29 @@ SIGGRAPH 2005, http://people.csail.mit.edu/ehsu/work/sig05stf/. Taylor's
 README: "The sample data we have included has been provided by Eugene Hsu".
 Distributed with Taylor's code (uoguelph-mlrg/mhmublv) under the Educational
 Community License 2.0; keep the notice and give credit.
+"""
+
+BANDAI_DESCR = """\
+Bandai Namco Research Motion dataset: walks in seven styles
+-----------------------------------------------------------
+
+The content *walk* of the second set of the Bandai Namco Research Motion
+dataset (BandaiNamcoResearchInc/Bandai-Namco-Research-Motiondataset): one
+actor walking in seven styles, takes 001-006 of each, with the style of each
+take from its JSON label file.
+
+**Data Set Characteristics:**
+
+    :Frames: 11,337 in 42 takes (200 to 466 frames each), 30 per second
+    :Styles: active, elderly, exhausted, feminine, masculine, normal,
+        youthful (6 takes each)
+    :Channels: 132 raw BVH channels: position and rotation (ZXY Euler
+        angles in degrees) of each of 22 joints
+    :Skeleton: a static ``joint_Root`` above the moving ``Hips``; Y up,
+        centimetres
+
+Licence: Creative Commons Attribution-NonCommercial 4.0 International (the
+``LICENSE`` file). Please cite: M. Kobayashi, C.-C. Liao, K. Inoue, S.
+Yojima, M. Takahashi, "Motion Capture Dataset for Practical Use of AI-based
+Motion Editing and Stylization", arXiv:2306.08861, 2023.
 """

@@ -3,15 +3,25 @@
 import hashlib
 import os
 import shutil
+import sys
 import urllib.request
 from dataclasses import dataclass
 
+from ._bandai import (
+    BANDAI_COMMIT,
+    BANDAI_FOLDER,
+    BANDAI_REPOSITORY,
+    BANDAI_SHA256,
+    bandai_source_path,
+)
 from ._base import CMU35_FOLDER, MIT_FOLDER, get_data_home
 
 __all__ = [
+    "BANDAI_WALK_FILES",
     "CMU35_FILES",
     "MIT_WALK_FILES",
     "RemoteFile",
+    "fetch_bandai_walks",
     "fetch_cmu35",
     "fetch_mit_walk",
 ]
@@ -67,8 +77,20 @@ MIT_WALK_FILES = (
                "d91828a48afe679eee20215b7657a0f54258654d3a2c9d6e943fec41dc7a0ddf"),
 )  # fmt: skip
 
+BANDAI_WALK_FILES = tuple(
+    RemoteFile(
+        BANDAI_FOLDER,
+        filename,
+        BANDAI_REPOSITORY,
+        BANDAI_COMMIT,
+        bandai_source_path(filename),
+        sha256,
+    )
+    for filename, sha256 in BANDAI_SHA256.items()
+)
 
-def fetch_cmu35(data_home=None, *, base_url=None, timeout=60.0):
+
+def fetch_cmu35(data_home=None, *, base_url=None, timeout=60.0, verbose=True):
     """Download the CMU subject 35 files used by :func:`load_cmu35`.
 
     Fetches ``cmu35WalkJog.mat``, ``cmu35TaylorScaleBias.mat``, ``35.asf``
@@ -89,6 +111,9 @@ def fetch_cmu35(data_home=None, *, base_url=None, timeout=60.0):
         ``{base_url}/{owner}/{repository}/{commit}/{path}``.
     timeout : float, default=60.0
         Seconds to wait for the server.
+    verbose : bool, default=True
+        Print each file as it is downloaded, with its size, to standard
+        error.
 
     Returns
     -------
@@ -106,10 +131,10 @@ def fetch_cmu35(data_home=None, *, base_url=None, timeout=60.0):
     >>> from sklearn_crbm.datasets import fetch_cmu35, load_cmu35
     >>> cmu = load_cmu35(fetch_cmu35())  # doctest: +SKIP
     """
-    return _fetch_files(CMU35_FILES, data_home, base_url, timeout)
+    return _fetch_files(CMU35_FILES, data_home, base_url, timeout, verbose)
 
 
-def fetch_mit_walk(data_home=None, *, base_url=None, timeout=60.0):
+def fetch_mit_walk(data_home=None, *, base_url=None, timeout=60.0, verbose=True):
     """Download Taylor's MIT walking data used by :func:`load_mit_walk`.
 
     Fetches ``taylor_mhmublv_mit/data.mat`` (uoguelph-mlrg/mhmublv) and, for
@@ -129,6 +154,8 @@ def fetch_mit_walk(data_home=None, *, base_url=None, timeout=60.0):
         See :func:`fetch_cmu35`.
     timeout : float, default=60.0
         Seconds to wait for the server.
+    verbose : bool, default=True
+        See :func:`fetch_cmu35`.
 
     Returns
     -------
@@ -146,19 +173,80 @@ def fetch_mit_walk(data_home=None, *, base_url=None, timeout=60.0):
     >>> from sklearn_crbm.datasets import fetch_mit_walk, load_mit_walk
     >>> mit = load_mit_walk(fetch_mit_walk())  # doctest: +SKIP
     """
-    return _fetch_files(MIT_WALK_FILES, data_home, base_url, timeout)
+    return _fetch_files(MIT_WALK_FILES, data_home, base_url, timeout, verbose)
 
 
-def _fetch_files(files, data_home, base_url, timeout):
+def fetch_bandai_walks(data_home=None, *, base_url=None, timeout=60.0, verbose=True):
+    """Download the Bandai Namco walks in seven styles for :func:`load_bandai_walks`.
+
+    Fetches the walks of the second set of the Bandai Namco Research Motion
+    dataset (BandaiNamcoResearchInc/Bandai-Namco-Research-Motiondataset, a
+    fixed commit) in the styles active, elderly, exhausted, feminine,
+    masculine, normal and youthful, takes 001-006 of each: 42 BVH files,
+    the JSON label file of each, ``style_label.txt`` and
+    ``content_label.txt`` (the label names) and the licence, into
+    ``data_home/bandai_walk_styles/`` (15 MB).  Files already there with
+    the right SHA-256 are not downloaded again.
+
+    The data are licensed under Creative Commons Attribution-NonCommercial
+    4.0 (``LICENSE``); cite Kobayashi et al., "Motion Capture Dataset for
+    Practical Use of AI-based Motion Editing and Stylization" (2023,
+    arXiv:2306.08861), as the repository asks.
+
+    Parameters
+    ----------
+    data_home : path-like, default=None
+        See :func:`get_data_home`; created if needed.
+    base_url : str, default=None
+        See :func:`fetch_cmu35`.
+    timeout : float, default=60.0
+        Seconds to wait for the server.
+    verbose : bool, default=True
+        See :func:`fetch_cmu35`.
+
+    Returns
+    -------
+    data_home : pathlib.Path
+        The folder, ready for :func:`load_bandai_walks`.
+
+    Raises
+    ------
+    OSError
+        If a download fails or a file does not have the expected SHA-256
+        (the bad file is deleted).
+
+    Examples
+    --------
+    >>> from sklearn_crbm.datasets import fetch_bandai_walks, load_bandai_walks
+    >>> walks = load_bandai_walks(fetch_bandai_walks())  # doctest: +SKIP
+    """
+    return _fetch_files(BANDAI_WALK_FILES, data_home, base_url, timeout, verbose)
+
+
+def _fetch_files(files, data_home, base_url, timeout, verbose):
     home = get_data_home(data_home)
+    missing = []
     for remote in files:
         target = home / remote.folder / remote.filename
         if target.is_file():
             if file_sha256(target) == remote.sha256:
                 continue
             target.unlink()
+        missing.append((remote, target))
+    for count, (remote, target) in enumerate(missing, start=1):
         target.parent.mkdir(parents=True, exist_ok=True)
-        _download(remote.url(base_url or GITHUB_RAW), target, remote.sha256, timeout)
+        url = remote.url(base_url or GITHUB_RAW)
+        if verbose and count == 1:
+            print(f"Downloading {len(missing)} files to {home}", file=sys.stderr)
+        _download(url, target, remote.sha256, timeout)
+        if verbose:
+            kilobytes = target.stat().st_size / 1000
+            print(
+                f"  [{count}/{len(missing)}] {remote.folder}/{remote.filename} "
+                f"({kilobytes:.0f} kB)",
+                file=sys.stderr,
+                flush=True,
+            )
     return home
 
 

@@ -9,18 +9,22 @@ from sklearn.utils import Bunch
 from ._acclaim import read_amc
 from ._bvh import read_bvh
 from ._frame_rate import RATIO_TOLERANCE, check_rate, kept_frames
+from ._labels import file_labels
 from ._skeleton import Skeleton
 
 __all__ = ["read_amc_folder", "read_bvh_folder"]
 
 
-def read_bvh_folder(folder, *, pattern="*.bvh", frame_rate=None):
+def read_bvh_folder(
+    folder, *, pattern="*.bvh", frame_rate=None, labels=None, label_names=None
+):
     """Read every BVH file of a folder into one long-format data set.
 
     Each file is one sequence, named by its path relative to ``folder``
     without the suffix; files are read in sorted order.  All files must
     have the same channels (the same joints and channel order), as trials
-    of one capture set do.
+    of one capture set do.  With ``labels``, each file also has a label (a
+    style, an actor...), given to each of its frames in ``target``.
 
     Parameters
     ----------
@@ -33,6 +37,27 @@ def read_bvh_folder(folder, *, pattern="*.bvh", frame_rate=None):
         Frame rate of the returned data.  Files recorded faster are brought
         down to it by dropping frames (see :func:`resample_frames`).
         ``None`` keeps the files' rate, which must then be the same for all.
+    labels : str, re.Pattern or callable, default=None
+        Where each file's label comes from:
+
+        - a str: that key of the JSON file of the same name beside each file,
+          as the Bandai Namco Research Motion dataset has them (``"style"``
+          reads ``walk_001.json``'s ``{"style": 2, ...}`` for
+          ``walk_001.bvh``);
+        - a compiled regular expression (:func:`re.compile`): searched in the
+          file's sequence name, whose first group (or, without groups, the
+          whole match) is the label, e.g. ``re.compile(r"walk_([a-z]+)_")``;
+        - a callable: called with each file's :class:`~pathlib.Path`, it
+          returns the label.
+
+        ``None`` reads no labels.
+    label_names : sequence of str or path-like, default=None
+        The names of the labels, in the order of their codes, or a text file
+        with one name a line.  Integer labels index into them; other labels
+        must be among them.  ``None``: for a JSON key, the file
+        ``{key}_label.txt`` in ``folder`` or in ``folder/../cfg`` when there
+        is one (the Bandai Namco repository's ``style_label.txt``), else the
+        distinct labels in sorted order.
 
     Returns
     -------
@@ -41,6 +66,11 @@ def read_bvh_folder(folder, *, pattern="*.bvh", frame_rate=None):
             Raw channels of all files, one after the other.
         sequence_ids : ndarray of shape (n_frames,)
             Index into ``sequence_names`` of every frame.
+        target : ndarray of shape (n_frames,)
+            Only with ``labels``: the code of every frame's label, an index
+            into ``target_names``.
+        target_names : ndarray
+            Only with ``labels``: the label names.
         sequence_names : ndarray of str
             One name per file, e.g. ``"walk_01"`` or ``"subject1/walk_01"``.
         feature_names : ndarray of str
@@ -59,10 +89,12 @@ def read_bvh_folder(folder, *, pattern="*.bvh", frame_rate=None):
     Raises
     ------
     FileNotFoundError
-        If ``folder`` is not a folder or has no file matching ``pattern``.
+        If ``folder`` is not a folder or has no file matching ``pattern``, or
+        a JSON label file is missing.
     ValueError
-        If a file is malformed, the files' channels differ, or their frame
-        rates differ and ``frame_rate`` is None.
+        If a file is malformed, the files' channels differ, their frame
+        rates differ and ``frame_rate`` is None, or a file's label is missing
+        or not among ``label_names``.
 
     Examples
     --------
@@ -76,17 +108,33 @@ def read_bvh_folder(folder, *, pattern="*.bvh", frame_rate=None):
     >>> walks = read_bvh_folder(folder, frame_rate=30.0)
     >>> walks.data.shape, walks.sequence_ids.tolist(), list(walks.sequence_names)
     ((4, 57), [0, 0, 1, 1], ['walk_0', 'walk_1'])
+
+    Labels from the file names, one per frame:
+
+    >>> import re
+    >>> walks = read_bvh_folder(folder, frame_rate=30.0,
+    ...                         labels=re.compile(r"walk_([0-9])"))
+    >>> walks.target.tolist(), list(walks.target_names)
+    ([0, 0, 1, 1], ['0', '1'])
     """
     folder, paths = _matching_files(folder, pattern)
     sequences = []
     for path in paths:
         skeleton, data, names, rate = read_bvh(path)
         sequences.append((path, skeleton, data, rate))
-    return _long_format(folder, sequences, frame_rate, "BVH")
+    bunch = _long_format(folder, sequences, frame_rate, "BVH")
+    return _with_labels(bunch, folder, paths, labels, label_names)
 
 
 def read_amc_folder(
-    folder, skeleton=None, *, pattern="*.amc", amc_frame_rate=120.0, frame_rate=None
+    folder,
+    skeleton=None,
+    *,
+    pattern="*.amc",
+    amc_frame_rate=120.0,
+    frame_rate=None,
+    labels=None,
+    label_names=None,
 ):
     """Read every AMC file of a folder into one long-format data set.
 
@@ -110,6 +158,10 @@ def read_amc_folder(
         Frame rate of the returned data: files are brought down to it by
         dropping frames (see :func:`resample_frames`).  ``None`` keeps
         ``amc_frame_rate``.
+    labels : str, re.Pattern or callable, default=None
+        Each file's label, as for :func:`read_bvh_folder`.
+    label_names : sequence of str or path-like, default=None
+        The names of the labels, as for :func:`read_bvh_folder`.
 
     Returns
     -------
@@ -146,7 +198,8 @@ def read_amc_folder(
             own = skeletons[asf]
         data, _ = read_amc(path, own)
         sequences.append((path, own, data, amc_frame_rate))
-    return _long_format(folder, sequences, frame_rate, "AMC")
+    bunch = _long_format(folder, sequences, frame_rate, "AMC")
+    return _with_labels(bunch, folder, paths, labels, label_names)
 
 
 def _matching_files(folder, pattern):
@@ -178,6 +231,20 @@ def _asf_for(amc_path):
             f"{amc_path.stem!r}. Pass skeleton= to read_amc_folder."
         )
     return max(prefixes, key=lambda asf: len(asf.stem))
+
+
+def _with_labels(bunch, folder, paths, labels, label_names):
+    """``bunch`` with every frame's label code (``target``) and ``target_names``."""
+    if labels is None:
+        if label_names is not None:
+            raise ValueError(
+                "label_names names the labels that labels= reads; pass labels= too."
+            )
+        return bunch
+    codes, names = file_labels(folder, paths, labels, label_names)
+    bunch.target = codes[bunch.sequence_ids]
+    bunch.target_names = names
+    return bunch
 
 
 def _long_format(folder, sequences, frame_rate, kind):

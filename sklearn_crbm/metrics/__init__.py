@@ -1,7 +1,9 @@
-"""Metrics for motion: the paper's fill-in error and generated-motion statistics.
+"""Metrics for motion: the paper's fill-in error, generated-motion statistics, style.
 
 :func:`judge_generated_motion` puts the statistics together: the style of
 every generated sequence and whether it died out, stalled or blew up.
+:class:`StyleJudge` names the style of windows of motion and whether they
+move like it.
 """
 
 from ._fillin import fillin_angle_rmse, fillin_error
@@ -14,8 +16,10 @@ from ._generation import (
     step_frequency,
 )
 from ._judge import judge_generated_motion
+from ._style import StyleJudge
 
 __all__ = [
+    "StyleJudge",
     "fillin_angle_rmse",
     "fillin_error",
     "forward_speed",

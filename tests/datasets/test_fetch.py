@@ -1,4 +1,4 @@
-"""fetch_cmu35 and fetch_mit_walk against a local HTTP server (never the internet)."""
+"""The fetch_* helpers against a local HTTP server (never the internet)."""
 
 import functools
 import shutil
@@ -8,8 +8,20 @@ from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 import numpy as np
 import pytest
 
-from sklearn_crbm.datasets import fetch_cmu35, fetch_mit_walk, load_cmu35, load_mit_walk
-from sklearn_crbm.datasets._fetch import CMU35_FILES, MIT_WALK_FILES, file_sha256
+from sklearn_crbm.datasets import (
+    fetch_bandai_walks,
+    fetch_cmu35,
+    fetch_mit_walk,
+    load_bandai_walks,
+    load_cmu35,
+    load_mit_walk,
+)
+from sklearn_crbm.datasets._fetch import (
+    BANDAI_WALK_FILES,
+    CMU35_FILES,
+    MIT_WALK_FILES,
+    file_sha256,
+)
 
 
 class _QuietHandler(SimpleHTTPRequestHandler):
@@ -31,7 +43,7 @@ def server(tmp_path, data_home):
     ``root/{owner}/{repository}/{commit}/{path}``, copied from the test data.
     """
     root = tmp_path / "remote"
-    for remote in CMU35_FILES + MIT_WALK_FILES:
+    for remote in CMU35_FILES + MIT_WALK_FILES + BANDAI_WALK_FILES:
         target = root / remote.repository / remote.commit / remote.path
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(data_home / remote.folder / remote.filename, target)
@@ -69,6 +81,29 @@ def test_fetch_cmu35_downloads_checks_and_skips(tmp_path, server):
     fetch_cmu35(home, base_url=base_url)
     assert len(requests) == 5 and requests[-1].endswith("/35.asf")
     assert file_sha256(home / "cmu_subject35" / "35.asf") == CMU35_FILES[2].sha256
+
+
+def test_fetch_bandai_walks_shows_progress_and_loads(tmp_path, server, capsys, data_home):
+    base_url, _, requests = server
+    home = tmp_path / "home"
+    assert fetch_bandai_walks(home, base_url=base_url) == home
+    assert len(requests) == 87  # 42 takes and their labels, 2 name files, licence
+    progress = capsys.readouterr().err.splitlines()
+    assert progress[0] == f"Downloading 87 files to {home}"
+    assert progress[1].startswith("  [1/87] bandai_walk_styles/LICENSE (")
+    assert progress[-1].startswith("  [87/87] bandai_walk_styles/dataset-2_walk_")
+    assert len(progress) == 88
+    walks = load_bandai_walks(home)
+    shared = load_bandai_walks(data_home)
+    np.testing.assert_array_equal(walks.data, shared.data)
+    np.testing.assert_array_equal(walks.target, shared.target)
+    # nothing to do the second time, and nothing printed; a damaged file again
+    fetch_bandai_walks(home, base_url=base_url)
+    assert len(requests) == 87 and capsys.readouterr().err == ""
+    (home / "bandai_walk_styles" / "style_label.txt").write_text("damaged")
+    fetch_bandai_walks(home, base_url=base_url, verbose=False)
+    assert requests[-1].endswith("/cfg/style_label.txt")
+    assert len(requests) == 88 and capsys.readouterr().err == ""
 
 
 def test_fetch_mit_walk(tmp_path, server, monkeypatch):
@@ -123,3 +158,28 @@ def test_default_urls_point_at_the_listed_commits():
     )
     assert len(set(urls)) == 7
     assert np.all([len(remote.sha256) == 64 for remote in CMU35_FILES + MIT_WALK_FILES])
+
+
+def test_bandai_urls_are_those_of_the_provenance_file(data_home):
+    """Every BVH file at the repository, path and commit its provenance names,
+    every other file (JSON labels, label names, licence) in the same commit,
+    and every hash that of the shared copy."""
+    folder = data_home / "bandai_walk_styles"
+    provenance = {}
+    for line in (folder / "PROVENANCE.tsv").read_text().splitlines():
+        filename, repository, path, commit = line.split("\t")
+        provenance[filename] = f"https://raw.githubusercontent.com/{repository}/{commit}/{path}"
+    remotes = {remote.filename: remote for remote in BANDAI_WALK_FILES}
+    assert sorted(remotes) == sorted(
+        p.name for p in folder.iterdir() if p.name not in ("README.md", "PROVENANCE.tsv")
+    )
+    for filename, url in provenance.items():
+        assert remotes[filename].url() == url
+        json_url = remotes[filename.replace(".bvh", ".json")].url()
+        assert json_url == url.replace(".bvh", ".json")
+    assert remotes["style_label.txt"].url().endswith(
+        "/74ead3ba1ae4696404e6086233779f60de8bf9ef/dataset/"
+        "Bandai-Namco-Research-Motiondataset-2/cfg/style_label.txt"
+    )
+    for filename, remote in remotes.items():
+        assert file_sha256(folder / filename) == remote.sha256, filename

@@ -1,0 +1,820 @@
+"""Many styles from one model: the factored CRBM and its alternatives (issue 29).
+
+Data: the Bandai Namco walks in seven styles (``load_bandai_walks``: takes
+001-006 of active, elderly, exhausted, feminine, masculine, normal and
+youthful, 30 frames per second), through the default
+``make_motion_preprocessor`` fitted on each split's training frames.
+
+Splits:
+
+``held-out``
+    Takes 001-005 of every style train; the takes 006 are held out.
+``one take``
+    For each style in turn: only its take 001 and all six takes of the
+    other styles train; its takes 002-006 are held out.
+
+Candidates (``--candidates``), each trained per seed of ``--seeds`` with the
+package's defaults (``--n-iter`` shortens training):
+
+``unlabelled``
+    (a) one ``ConditionalRBM`` on every style, without the labels: its style
+    is the style of the frames that seed it.
+``separate``
+    (b) seven ``ConditionalRBM``, one per style; a transition switches from
+    one model to the other, a blend is beyond it.
+
+A candidate is a subclass of :class:`Candidate`; adding one (the
+``FactoredCRBM``, or a CRBM with the labels as additive inputs) is a class
+of a few lines and an entry in ``CANDIDATES``.
+
+Measurements (the issue's "Done when"), each of ``--parts``:
+
+``style``
+    Per style, ``--n-sequences`` sequences of ``--n-frames`` frames seeded
+    with real frames of a *normal* walk and asked for the style (the
+    unlabelled model, which cannot be asked, also seeded with frames of the
+    style itself): the share of 2-s windows from frame 100 on that the
+    judge (``StyleJudge`` trained on all 42 real takes) calls the style
+    ("kept"), the share also alive, and over the last 100 frames the leg
+    amplitude and step frequency of every sequence as a ratio to the
+    style's real 100-frame windows (pass: within 25% and 15%); blow-ups
+    (a channel beyond twice its largest magnitude in the real takes, whose
+    toes reach 13.5 standard deviations).
+``blends``
+    The 21 pairs of styles at 50/50: windows judged as one of the two;
+    forward speed and step frequency between the two styles' real ones
+    (within 10% of their difference).
+``transitions``
+    The 42 ordered pairs, seeded with frames of the first style, switched
+    to the second at half the sequence: windows from 60 frames after the
+    switch judged as the new style, and alive.
+``likelihood``
+    Held-out log-likelihood per frame of the takes 006 with their labels
+    (frames from the 13th of each take, so that every order up to 12 has a
+    full history), with the standard error of the annealed estimate and the
+    gap to the reverse (conservative) estimate.
+``recognition``
+    The style of the first 300 frames of every take 006: by Bayes' rule
+    from the per-frame log-likelihoods under each style, equal priors.
+``fillin``
+    The left leg (``UpperLeg_L`` down) or the upper body (``Spine`` up) of
+    every take 006 erased from half-way: the log ratio of the paper's
+    fill-in error to the best of ``KNNImputer(5)``, ``KNNImputer(10)`` and
+    ``AutoregressiveImputer()``, averaged over styles, parts and seeds, with
+    a 95% bootstrap interval.
+``one-take``
+    The one-take split: for every style, the share of windows kept and
+    alive (the unlabelled model seeded with frames of its take 001, the
+    others with a normal walk's), and the held-out log-likelihood of its
+    takes 002-006 (for ``separate``: of the CRBM trained on that one take).
+``speed``
+    Training seconds per epoch (``separate``: its seven models together);
+    generation frames per second for one sequence and per sequence of 100
+    generated together (the default Gibbs steps).
+
+Run from the repository root, e.g.::
+
+    python benchmarks/styles.py --seeds 0 --n-iter 50
+    python benchmarks/styles.py --parts style likelihood --candidates separate
+
+Prints one table and writes JSON to ``benchmarks/results/styles.json``.
+"""
+
+import os
+
+# One BLAS thread per process: the matrices are small, and threads only
+# fight on a shared machine.  Must be set before numpy is imported.
+for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")
+
+import argparse  # noqa: E402
+import itertools  # noqa: E402
+import json  # noqa: E402
+import time  # noqa: E402
+from abc import ABC, abstractmethod  # noqa: E402
+from dataclasses import dataclass  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+import sklearn  # noqa: E402
+from sklearn.frozen import FrozenEstimator  # noqa: E402
+from sklearn.impute import KNNImputer  # noqa: E402
+
+from sklearn_crbm import ConditionalRBM, CRBMImputer  # noqa: E402
+from sklearn_crbm.datasets import bone_columns, load_bandai_walks  # noqa: E402
+from sklearn_crbm.impute import AutoregressiveImputer  # noqa: E402
+from sklearn_crbm.metrics import (  # noqa: E402
+    StyleJudge,
+    forward_speed,
+    step_frequency,
+)
+from sklearn_crbm.model_selection import (  # noqa: E402
+    make_fillin_cases,
+    paper_body_parts,
+)
+from sklearn_crbm.preprocessing import make_motion_preprocessor  # noqa: E402
+from sklearn_crbm.utils import random_windows  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+FRAME_RATE = 30.0
+NORMAL = "normal"
+LEGS = ("UpperLeg_L", "UpperLeg_R", "LowerLeg_L", "LowerLeg_R")
+BODY_PARTS = dict(left_leg="UpperLeg_L", upper_body="Spine")
+JUDGED_FROM = 100  # first frame of the windows judged
+AFTER_SWITCH = 60  # frames after a transition's switch before windows count
+LAST_FRAMES = 100  # frames of the amplitude and frequency check
+SCORED_FROM = 12  # frames of each held-out take not scored (full histories)
+RECOGNITION_FRAMES = 300
+BLOWN_UP = 2.0  # a channel beyond this times its largest real |z| has blown up
+PARTS = (
+    "style",
+    "blends",
+    "transitions",
+    "likelihood",
+    "recognition",
+    "fillin",
+    "one-take",
+    "speed",
+)
+
+
+# ------------------------------------------------------------------- data
+@dataclass
+class Split:
+    """One split, preprocessed, with the instruments that judge its motion."""
+
+    styles: list  # the style names, in the order of the label weights
+    pre: object  # the fitted preprocessor
+    walks: object  # load_bandai_walks()
+    train: np.ndarray  # frames (rows of walks.data) that train
+    test: np.ndarray  # frames held out
+    Z: np.ndarray  # every take, preprocessed
+    legs: np.ndarray  # columns of the hips and knees
+    limit: np.ndarray  # per channel, |z| beyond which motion has blown up
+    judge: StyleJudge  # 2-s windows: style, and alive
+    pace: StyleJudge  # 100-frame windows: amplitude and frequency references
+    real_speed: dict  # style: mean forward speed of its real takes
+    real_frequency: dict  # style: step frequency (Hz) of its real takes
+
+    def frames(self, rows):
+        """``(Z, styles, sequence_ids)`` of the given rows."""
+        walks = self.walks
+        return self.Z[rows], walks.target_names[walks.target[rows]], walks.sequence_ids[rows]
+
+    def takes_of(self, style, rows):
+        """Sequence ids of the takes of ``style`` among ``rows``."""
+        Z, styles, ids = self.frames(rows)
+        return np.unique(ids[styles == style])
+
+
+def make_split(walks, train):
+    """The split that trains on the frames ``train`` and holds out the rest."""
+    styles = sorted(walks.target_names)  # the columns of the label weights
+    ids = walks.sequence_ids
+    with sklearn.config_context(enable_metadata_routing=True):
+        pre = make_motion_preprocessor(walks.skeleton)
+        pre.fit(walks.data[train], sequence_ids=ids[train])
+        Z = pre.transform(walks.data, sequence_ids=ids)
+    names = pre.get_feature_names_out()
+    legs = bone_columns(names, LEGS)
+    labels = walks.target_names[walks.target]
+    judge = StyleJudge(legs=legs).fit(Z, labels, sequence_ids=ids)
+    pace = StyleJudge(window=LAST_FRAMES, stride=10, legs=legs).fit(
+        Z, labels, sequence_ids=ids
+    )
+    speed = forward_speed(Z, sequence_ids=ids, feature_names=names)
+    frequency = step_frequency(
+        Z, sequence_ids=ids, features=legs, frame_rate=FRAME_RATE
+    )
+    take_styles = labels[np.searchsorted(ids, np.arange(ids.max() + 1))]
+    return Split(
+        styles=styles,
+        pre=pre,
+        walks=walks,
+        train=train,
+        test=~train,
+        Z=Z,
+        legs=legs,
+        limit=BLOWN_UP * np.abs(Z).max(axis=0),
+        judge=judge,
+        pace=pace,
+        real_speed={s: float(speed[take_styles == s].mean()) for s in styles},
+        real_frequency={s: float(frequency[take_styles == s].mean()) for s in styles},
+    )
+
+
+def seed_windows(split, style, width, n_windows, rng):
+    """``n_windows`` windows of ``width`` real training frames of ``style``."""
+    Z, _, ids = split.frames(split.train)
+    return random_windows(
+        Z,
+        sequence_ids=ids,
+        width=width,
+        n_windows=n_windows,
+        sequences=split.takes_of(style, split.train),
+        random_state=rng,
+    )
+
+
+def label_weights(styles, n_frames, first, second=None, switch=None, blend=None):
+    """Per-frame label weights: one style, a 50/50 ``blend``, or a switch."""
+    weights = np.zeros((n_frames, len(styles)))
+    weights[:, styles.index(first)] = 1.0
+    if blend is not None:
+        weights[:, styles.index(first)] = 1.0 - blend
+        weights[:, styles.index(second)] = blend
+    if switch is not None:
+        weights[switch:] = 0.0
+        weights[switch:, styles.index(second)] = 1.0
+    return weights
+
+
+# ------------------------------------------------------------- candidates
+class Candidate(ABC):
+    """A model of many styles, as the benchmark drives it."""
+
+    name = ""
+    controls_style = True  # False: its style is that of the frames seeding it
+
+    @abstractmethod
+    def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
+        """Train on labelled frames; ``only``: the styles that will be asked for.
+
+        The columns of the label weights that generation follows are the
+        sorted styles, as a classifier's ``classes_``.
+        """
+
+    @abstractmethod
+    def history_length(self):
+        """Seed frames that generation needs."""
+
+    @abstractmethod
+    def can_generate(self, weights):
+        """Whether it can follow these per-frame label weights."""
+
+    @abstractmethod
+    def generate(self, weights, history, random_state):
+        """Frames (n_sequences * n_frames, n_features) following ``weights``."""
+
+    @abstractmethod
+    def log_likelihood(self, Z, styles, sequence_ids, seed):
+        """Per frame ``(estimate, standard error, reverse estimate)`` given labels."""
+
+    def recognise(self, Z, sequence_ids, styles, seed):
+        """The style of every sequence, or None if it cannot tell."""
+        return None
+
+    @abstractmethod
+    def imputer(self, style, Z, sequence_ids, seed):
+        """A fitted imputer for sequences of ``style`` (trained on ``Z``)."""
+
+    @abstractmethod
+    def n_parameters(self):
+        """Number of trained parameters."""
+
+
+def _crbm_parameters(model):
+    return sum(
+        getattr(model, name).size
+        for name in (
+            "components_",
+            "intercept_hidden_",
+            "intercept_visible_",
+            "autoregressive_",
+            "past_to_hidden_",
+        )
+    )
+
+
+def _crbm(seed, n_iter):
+    """A ConditionalRBM with the package's defaults (but ``n_iter`` if given)."""
+    model = ConditionalRBM(random_state=seed)
+    return model if n_iter is None else model.set_params(n_iter=n_iter)
+
+
+def _estimate(model, Z, sequence_ids, seed):
+    result = model.estimate_log_likelihood(
+        Z, sequence_ids=sequence_ids, reverse=True, random_state=seed
+    )
+    return result.log_likelihood, result.standard_error, result.lower
+
+
+class Unlabelled(Candidate):
+    """(a) One ConditionalRBM on every style, without the labels."""
+
+    name = "unlabelled"
+    controls_style = False
+
+    def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
+        self.model = _crbm(seed, n_iter).fit(Z, sequence_ids=sequence_ids)
+        return self
+
+    def history_length(self):
+        return self.model.history_length
+
+    def can_generate(self, weights):
+        # it ignores them, so it only makes sense for one style throughout
+        return bool(np.all(weights == weights[:1]) and weights.max() == 1.0)
+
+    def generate(self, weights, history, random_state):
+        return self.model.sample(
+            len(weights), history=history, random_state=random_state
+        )
+
+    def log_likelihood(self, Z, styles, sequence_ids, seed):
+        return _estimate(self.model, Z, sequence_ids, seed)
+
+    def imputer(self, style, Z, sequence_ids, seed):
+        imputer = CRBMImputer(FrozenEstimator(self.model), random_state=seed)
+        return imputer.fit(Z, sequence_ids=sequence_ids)
+
+    def n_parameters(self):
+        return _crbm_parameters(self.model)
+
+
+class Separate(Candidate):
+    """(b) One ConditionalRBM per style; a transition switches models."""
+
+    name = "separate"
+
+    def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
+        self.classes_ = np.unique(styles)
+        wanted = self.classes_ if only is None else only
+        self.models = {
+            style: _crbm(seed, n_iter).fit(
+                Z[styles == style], sequence_ids=sequence_ids[styles == style]
+            )
+            for style in wanted
+        }
+        return self
+
+    def history_length(self):
+        return max(model.history_length for model in self.models.values())
+
+    def can_generate(self, weights):
+        return bool(np.all(weights.max(axis=1) == 1.0))  # one style at every frame
+
+    def generate(self, weights, history, random_state):
+        """Each run of frames of one style from that style's model."""
+        styles = np.argmax(weights, axis=1)
+        runs = np.flatnonzero(np.diff(styles)) + 1
+        parts, past = [], history
+        for start, stop in zip(np.r_[0, runs], np.r_[runs, len(styles)], strict=True):
+            model = self.models[self.classes_[styles[start]]]
+            new = model.sample(stop - start, history=past, random_state=random_state)
+            new = new.reshape(len(history), stop - start, -1)
+            parts.append(new)
+            past = np.concatenate([past, new], axis=1)[:, -self.history_length() :]
+        return np.concatenate(parts, axis=1).reshape(-1, history.shape[2])
+
+    def log_likelihood(self, Z, styles, sequence_ids, seed):
+        estimate, error, lower = (np.empty(len(Z)) for _ in range(3))
+        for style in np.unique(styles):
+            rows = styles == style
+            estimate[rows], error[rows], lower[rows] = _estimate(
+                self.models[style], Z[rows], sequence_ids[rows], seed
+            )
+        return estimate, error, lower
+
+    def recognise(self, Z, sequence_ids, styles, seed):
+        scored = _scored_frames(sequence_ids)
+        totals = []
+        for style in styles:
+            estimate = _estimate(self.models[style], Z, sequence_ids, seed)[0]
+            totals.append(
+                [estimate[scored & (sequence_ids == k)].sum() for k in np.unique(sequence_ids)]
+            )
+        return np.asarray(styles, dtype=object)[np.argmax(totals, axis=0)]
+
+    def imputer(self, style, Z, sequence_ids, seed):
+        imputer = CRBMImputer(FrozenEstimator(self.models[style]), random_state=seed)
+        return imputer.fit(Z, sequence_ids=sequence_ids)
+
+    def n_parameters(self):
+        return sum(_crbm_parameters(model) for model in self.models.values())
+
+
+CANDIDATES = {candidate.name: candidate for candidate in (Unlabelled, Separate)}
+
+
+# ----------------------------------------------------------- measurements
+def _scored_frames(sequence_ids):
+    """Frames with at least SCORED_FROM frames before them in their sequence."""
+    starts = np.r_[0, np.flatnonzero(np.diff(sequence_ids)) + 1]
+    position = np.arange(len(sequence_ids)) - np.repeat(
+        starts, np.diff(np.r_[starts, len(sequence_ids)])
+    )
+    return position >= SCORED_FROM
+
+
+def _draw_seed(rng):
+    """An int seed from ``rng`` (the estimators take ints or RandomStates)."""
+    return int(rng.integers(np.iinfo(np.int32).max))
+
+
+def generated_ids(n_sequences, n_frames):
+    return np.repeat(np.arange(n_sequences), n_frames)
+
+
+def _blown_up(split, frames, n_sequences):
+    """Sequences with a value beyond its channel's limit (or not finite)."""
+    beyond = ~(np.abs(frames) <= split.limit)  # NaN counts as beyond
+    return beyond.reshape(n_sequences, -1).any(axis=1)
+
+
+def judge_generated(split, frames, weights, n_sequences):
+    """Windows judged, kept and alive; last frames' pace; blow-ups."""
+    n_frames = len(weights)
+    ids = generated_ids(n_sequences, n_frames)
+    requested = np.asarray(split.styles, dtype=object)[np.argmax(weights, axis=1)]
+    blown = _blown_up(split, frames, n_sequences)
+    finite = np.where(np.isfinite(frames), frames, 0.0)
+    verdict = split.judge.verdict(finite, np.tile(requested, n_sequences), sequence_ids=ids)
+    last = np.arange(len(frames)).reshape(n_sequences, n_frames)[:, -LAST_FRAMES:]
+    pace = split.pace.verdict(
+        finite[last.ravel()],
+        np.repeat(requested[-1], last.size),
+        sequence_ids=generated_ids(n_sequences, LAST_FRAMES),
+    )
+    return verdict, pace, blown
+
+
+def style_kept(candidate, split, args, rng):
+    """Per style: windows kept and alive, last-frame pace, blow-ups."""
+    rows = {}
+    seeds = [(NORMAL, "normal seeds")]
+    if not candidate.controls_style:
+        seeds.append((None, "own seeds"))
+    for seed_style, label in seeds:
+        for style in split.styles:
+            weights = label_weights(split.styles, args.n_frames, style)
+            history = seed_windows(
+                split, seed_style or style, candidate.history_length(), args.n_sequences, rng
+            )
+            frames = candidate.generate(weights, history, _draw_seed(rng))
+            verdict, pace, blown = judge_generated(split, frames, weights, args.n_sequences)
+            judged = verdict.starts >= JUDGED_FROM
+            rows.setdefault(label, {})[style] = dict(
+                kept=float(verdict.correct[judged].mean()),
+                kept_alive=float(verdict.accepted[judged].mean()),
+                amplitude_ratio=pace.amplitude_ratio.tolist(),
+                frequency_ratio=pace.frequency_ratio.tolist(),
+                pace_ok=int(np.sum(pace.alive)),
+                blown_up=int(blown.sum()),
+            )
+    return rows
+
+
+def blends(candidate, split, args, rng):
+    names = split.pre.get_feature_names_out()
+    cells = {}
+    for first, second in itertools.combinations(split.styles, 2):
+        weights = label_weights(split.styles, args.n_frames, first, second, blend=0.5)
+        if not candidate.can_generate(weights):
+            return None
+        history = seed_windows(split, NORMAL, candidate.history_length(), args.n_sequences, rng)
+        frames = candidate.generate(weights, history, _draw_seed(rng))
+        blown = _blown_up(split, frames, args.n_sequences)
+        frames = np.where(np.isfinite(frames), frames, 0.0)
+        ids = generated_ids(args.n_sequences, args.n_frames)
+        verdict = split.judge.verdict(frames, sequence_ids=ids)
+        judged = verdict.starts >= JUDGED_FROM
+        later = np.tile(np.arange(args.n_frames) >= JUDGED_FROM, args.n_sequences)
+        speed = forward_speed(frames[later], sequence_ids=ids[later], feature_names=names)
+        frequency = step_frequency(
+            frames[later], sequence_ids=ids[later], features=split.legs, frame_rate=FRAME_RATE
+        )
+        between = [
+            _between(np.mean(value), real[first], real[second])
+            for value, real in ((speed, split.real_speed), (frequency, split.real_frequency))
+        ]
+        cells[f"{first}/{second}"] = dict(
+            one_of_two=float(np.isin(verdict.predicted[judged], [first, second]).mean()),
+            speed_between=between[0],
+            frequency_between=between[1],
+            blown_up=int(blown.sum()),
+        )
+    return cells
+
+
+def _between(value, a, b, margin=0.1):
+    low, high = min(a, b), max(a, b)
+    return bool(low - margin * (high - low) <= value <= high + margin * (high - low))
+
+
+def transitions(candidate, split, args, rng):
+    cells = {}
+    switch = args.n_frames // 2
+    for first, second in itertools.permutations(split.styles, 2):
+        weights = label_weights(split.styles, args.n_frames, first, second, switch=switch)
+        if not candidate.can_generate(weights):
+            return None
+        history = seed_windows(split, first, candidate.history_length(), args.n_sequences, rng)
+        frames = candidate.generate(weights, history, _draw_seed(rng))
+        verdict, _, blown = judge_generated(split, frames, weights, args.n_sequences)
+        judged = verdict.starts >= switch + AFTER_SWITCH
+        cells[f"{first}->{second}"] = dict(
+            new_style=float(verdict.correct[judged].mean()),
+            alive=float(verdict.alive[judged].mean()),
+            blown_up=int(blown.sum()),
+        )
+    return cells
+
+
+def likelihood(candidate, split, rows, seed):
+    Z, styles, ids = split.frames(rows)
+    estimate, error, lower = candidate.log_likelihood(Z, styles, ids, seed)
+    scored = _scored_frames(ids)
+    return dict(
+        mean=float(estimate[scored].mean()),
+        standard_error=float(np.sqrt(np.sum(error[scored] ** 2)) / scored.sum()),
+        reverse_gap=float(np.mean(estimate[scored] - lower[scored])),
+        n_frames=int(scored.sum()),
+    )
+
+
+def recognition(candidate, split, seed):
+    Z, styles, ids = split.frames(split.test)
+    first = np.concatenate(
+        [np.flatnonzero(ids == k)[:RECOGNITION_FRAMES] for k in np.unique(ids)]
+    )
+    named = candidate.recognise(Z[first], ids[first], split.styles, seed)
+    if named is None:
+        return None
+    truth = [styles[ids == k][0] for k in np.unique(ids)]
+    return dict(correct=int(np.sum(named == np.asarray(truth, dtype=object))), of=len(truth))
+
+
+def fillin(candidate, split, seed):
+    """Log ratio of the candidate's fill-in error to the best simple baseline's."""
+    Z, _, ids = split.frames(split.train)
+    baselines = [
+        KNNImputer(n_neighbors=5).fit(Z),
+        KNNImputer(n_neighbors=10).fit(Z),
+        AutoregressiveImputer().fit(Z, sequence_ids=ids),
+    ]
+    walks = split.walks
+    held_out = {
+        walks.target_names[walks.target[walks.sequence_ids == k][0]]: walks.sequence_names[k]
+        for k in np.unique(walks.sequence_ids[split.test])
+    }
+    cases = make_fillin_cases(
+        walks,
+        split.pre,
+        trials=held_out,
+        body_parts=paper_body_parts(walks.skeleton, **BODY_PARTS),
+    )
+    ratios, imputers = {}, {}
+    for (style, part), case in cases.items():
+        best = min(case.errors(b.transform(case.X_missing))[0] for b in baselines)
+        if style not in imputers:
+            imputers[style] = candidate.imputer(style, Z, ids, seed)
+        filled = imputers[style].transform(case.X_missing)
+        ratios[f"{style}/{part}"] = float(np.log(case.errors(filled)[0] / best))
+    return ratios
+
+
+def one_take(name, walks, args, seed, rng):
+    """Per style: trained on its take 001 and the other styles' six takes."""
+    cells = {}
+    labels = walks.target_names[walks.target]
+    takes = walks.takes[walks.sequence_ids]
+    for style in walks.target_names:
+        train = (labels != style) | (takes == 1)
+        split = make_split(walks, train)
+        Z, styles, ids = split.frames(train)
+        candidate = CANDIDATES[name]().fit(
+            Z, styles, ids, seed=seed, n_iter=args.n_iter, only=[style]
+        )
+        weights = label_weights(split.styles, args.n_frames, style)
+        seed_style = NORMAL if candidate.controls_style else style
+        history = seed_windows(split, seed_style, candidate.history_length(), args.n_sequences, rng)
+        frames = candidate.generate(weights, history, _draw_seed(rng))
+        verdict, pace, blown = judge_generated(split, frames, weights, args.n_sequences)
+        judged = verdict.starts >= JUDGED_FROM
+        cells[style] = dict(
+            kept=float(verdict.correct[judged].mean()),
+            kept_alive=float(verdict.accepted[judged].mean()),
+            pace_ok=int(np.sum(pace.alive)),
+            blown_up=int(blown.sum()),
+            log_likelihood=likelihood(candidate, split, ~train, seed),
+        )
+        print(f"    one take, {style}: {cells[style]['kept']:.0%} kept", flush=True)
+    return cells
+
+
+def speed(candidate, split, n_frames_trained, n_iter, fit_seconds, rng):
+    """Training time per epoch; generation frames per second, 1 and 100 sequences."""
+    weights = label_weights(split.styles, 300, NORMAL)
+    rates = {}
+    for n_sequences in (1, 100):
+        history = seed_windows(split, NORMAL, candidate.history_length(), n_sequences, rng)
+        start = time.perf_counter()
+        candidate.generate(weights, history, _draw_seed(rng))
+        rates[n_sequences] = len(weights) * n_sequences / (time.perf_counter() - start)
+    return dict(
+        seconds_per_epoch=fit_seconds / n_iter,
+        training_frames_per_second=n_frames_trained * n_iter / fit_seconds,
+        generation_fps_one=rates[1],
+        generation_fps_per_sequence_of_100=rates[100] / 100,
+    )
+
+
+# ----------------------------------------------------------------- report
+def _percent(values):
+    return f"{100 * np.mean(values):.0f}%"
+
+
+def _ratio_range(values):
+    values = np.asarray(values, dtype=float)
+    if np.all(np.isnan(values)):
+        return "nan"
+    return f"{np.nanmin(values):.2f}-{np.nanmax(values):.2f}"
+
+
+def bootstrap_interval(values, rng, n_resamples=10_000):
+    """95% bootstrap interval of the mean of ``values``."""
+    values = np.asarray(values)
+    means = rng.choice(values, size=(n_resamples, len(values))).mean(axis=1)
+    return np.percentile(means, [2.5, 97.5])
+
+
+def _kept(cells):
+    return f"{_percent([c['kept'] for c in cells])} ({_percent([c['kept_alive'] for c in cells])})"
+
+
+def _pace(cells):
+    passed = sum(c["pace_ok"] for c in cells)
+    total = sum(len(c["amplitude_ratio"]) for c in cells)
+    amplitude = _ratio_range([r for c in cells for r in c["amplitude_ratio"]])
+    frequency = _ratio_range([r for c in cells for r in c["frequency_ratio"]])
+    return f"{passed}/{total}; amp {amplitude}, freq {frequency}"
+
+
+def _blends(cells):
+    between = sum(c["speed_between"] and c["frequency_between"] for c in cells)
+    return f"{_percent([c['one_of_two'] for c in cells])}; {between}/{len(cells)}"
+
+
+def _transitions(cells):
+    return f"{_percent([c['new_style'] for c in cells])} ({_percent([c['alive'] for c in cells])})"
+
+
+def _mean(cells, key):
+    return np.mean([cell[key] for cell in cells])
+
+
+def _likelihood(cells):
+    mean, error, gap = (_mean(cells, k) for k in ("mean", "standard_error", "reverse_gap"))
+    return f"{mean:.2f} (SE {error:.1e}, gap {gap:.1e})"
+
+
+def _recognition(cells):
+    correct = [c["correct"] for c in cells]
+    return f"{min(correct)}-{max(correct)}/{cells[0]['of']}"
+
+
+def _one_take(cells):
+    mean = np.mean([c["log_likelihood"]["mean"] for c in cells])
+    return f"{_kept(cells)}; LL {mean:.2f}"
+
+
+def _speed(cells):
+    epoch, one, many = (
+        _mean(cells, k)
+        for k in (
+            "seconds_per_epoch",
+            "generation_fps_one",
+            "generation_fps_per_sequence_of_100",
+        )
+    )
+    return f"{epoch:.3f} s/epoch; {one:.0f}, {many:.0f}/seq fps"
+
+
+# (column, part of the results, formatter of its cells over the seeds).  A
+# part's result per seed is one cell (ONE_CELL_PARTS) or a dict of cells:
+# per style (style, one-take), per pair (blends, transitions), per case
+# (fill-in log ratios).
+ONE_CELL_PARTS = ("likelihood", "recognition", "speed")
+COLUMNS = [
+    ("kept (alive)", "style", _kept),
+    ("last 100 frames in pace", "style", _pace),
+    ("blown up", "style", lambda cells: str(sum(c["blown_up"] for c in cells))),
+    ("blends: 1 of 2; between", "blends", _blends),
+    ("transitions: new (alive)", "transitions", _transitions),
+    ("held-out LL/frame", "likelihood", _likelihood),
+    ("recognised", "recognition", _recognition),
+    ("one take: kept (alive); LL", "one-take", _one_take),
+    ("speed: training; generation", "speed", _speed),
+]
+
+
+def _cells(per_seed, part, seeding):
+    """Every cell of ``part`` over the seeds (of one seeding for "style")."""
+    cells = []
+    for result in per_seed.values():
+        found = result.get(part)
+        if part == "style" and found is not None:
+            found = found.get(seeding)
+        if found is None:
+            continue
+        cells += [found] if part in ONE_CELL_PARTS else list(found.values())
+    return cells
+
+
+def table(results, rng):
+    """One row per candidate (and seeding), its measurements over the seeds."""
+    header = ["candidate", "params", *(name for name, _, _ in COLUMNS)]
+    header.append("fill-in log ratio [95%]")
+    rows = []
+    for name, per_seed in results.items():
+        first = next(iter(per_seed.values()))
+        for k, seeding in enumerate(first.get("style") or {"": None}):
+            row = [f"{name} ({seeding})" if seeding else name, str(first["n_parameters"])]
+            for _, part, formatter in COLUMNS:
+                cells = _cells(per_seed, part, seeding)
+                shown = cells and (part == "style" or k == 0)
+                row.append(formatter(cells) if shown else "-")
+            ratios = _cells(per_seed, "fillin", seeding)
+            if ratios and k == 0:
+                low, high = bootstrap_interval(ratios, rng)
+                row.append(f"{np.mean(ratios):+.3f} [{low:+.3f}, {high:+.3f}]")
+            else:
+                row.append("-")
+            rows.append(row)
+    widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
+    for row in [header, None, *rows]:
+        if row is None:
+            print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
+        else:
+            print("| " + " | ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)) + " |")
+
+
+# ------------------------------------------------------------------- main
+def run_candidate(name, walks, split, args, seed):
+    Z, styles, ids = split.frames(split.train)
+    rng = np.random.default_rng(seed)
+    start = time.perf_counter()
+    candidate = CANDIDATES[name]().fit(Z, styles, ids, seed=seed, n_iter=args.n_iter)
+    fit_seconds = time.perf_counter() - start
+    print(f"  {name}, seed {seed}: trained in {fit_seconds:.0f} s", flush=True)
+    out = {"n_parameters": int(candidate.n_parameters()), "fit_seconds": fit_seconds}
+    if "style" in args.parts:
+        out["style"] = style_kept(candidate, split, args, rng)
+    if "blends" in args.parts:
+        out["blends"] = blends(candidate, split, args, rng)
+    if "transitions" in args.parts:
+        out["transitions"] = transitions(candidate, split, args, rng)
+    if "likelihood" in args.parts:
+        out["likelihood"] = likelihood(candidate, split, split.test, seed)
+    if "recognition" in args.parts:
+        out["recognition"] = recognition(candidate, split, seed)
+    if "fillin" in args.parts:
+        out["fillin"] = fillin(candidate, split, seed)
+    if "speed" in args.parts:
+        n_iter = args.n_iter or ConditionalRBM().n_iter
+        out["speed"] = speed(candidate, split, len(Z), n_iter, fit_seconds, rng)
+    if "one-take" in args.parts:
+        out["one-take"] = one_take(name, walks, args, seed, rng)
+    return out
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--data-home", default=str(REPO.parent / "shared" / "data"))
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
+    parser.add_argument(
+        "--n-iter", type=int, default=None, help="epochs (default: the package's)"
+    )
+    parser.add_argument("--candidates", nargs="+", default=list(CANDIDATES), choices=list(CANDIDATES))
+    parser.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
+    parser.add_argument("--n-frames", type=int, default=1000)
+    parser.add_argument("--n-sequences", type=int, default=6)
+    parser.add_argument(
+        "--output", default=str(REPO / "benchmarks" / "results" / "styles.json")
+    )
+    args = parser.parse_args(argv)
+
+    sklearn.set_config(enable_metadata_routing=True)
+    walks = load_bandai_walks(args.data_home)
+    split = make_split(walks, walks.takes[walks.sequence_ids] <= 5)
+    results = {}
+    for name in args.candidates:
+        results[name] = {
+            seed: run_candidate(name, walks, split, args, seed) for seed in args.seeds
+        }
+    print(
+        f"\nBandai walks, 7 styles; trained on takes 001-005, judged over "
+        f"{args.n_sequences} x {args.n_frames} frames per style; seeds {args.seeds}, "
+        f"n_iter {args.n_iter or 'default'}\n"
+    )
+    table(results, np.random.default_rng(0))
+    output = Path(args.output)
+    output.parent.mkdir(parents=True, exist_ok=True)
+    output.write_text(json.dumps({"args": vars(args), "results": results}, indent=1))
+    print(f"\nwrote {output}")
+    return results
+
+
+if __name__ == "__main__":
+    main()

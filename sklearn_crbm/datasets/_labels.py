@@ -1,0 +1,161 @@
+"""Labels of the files of a folder: from a JSON file beside each, the name, a function.
+
+A labelled corpus gives every motion file one label (a style, an actor, a
+motion): the Bandai Namco Research Motion dataset puts ``{"content": 0,
+"style": 2}`` in a JSON file beside each BVH file and names the labels, one a
+line, in ``style_label.txt`` and ``content_label.txt``; other corpora put the
+label in the file name (``walk_elderly_003.bvh``).  :func:`file_labels`
+turns either into integer codes and label names.
+"""
+
+import json
+import os
+import re
+from numbers import Integral
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["file_labels"]
+
+# Where a corpus keeps the names of the labels of a JSON key: beside the files,
+# or (the Bandai Namco repository) in a "cfg" folder beside the data folder.
+LABEL_NAME_FILES = ("{key}_label.txt", "../cfg/{key}_label.txt")
+
+
+def file_labels(folder, paths, labels, label_names=None):
+    """Integer code of every file's label, and the names the codes index.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        The folder that was read.
+    paths : list of pathlib.Path
+        The files, in order.
+    labels : str, re.Pattern or callable
+        See :func:`~sklearn_crbm.datasets.read_bvh_folder`.
+    label_names : sequence of str, path-like or None
+        See :func:`~sklearn_crbm.datasets.read_bvh_folder`.
+
+    Returns
+    -------
+    codes : ndarray of shape (n_files,)
+        Index into ``names`` of each file's label.
+    names : ndarray
+        The label names.
+    """
+    if isinstance(labels, str):
+        values = [_json_label(path, labels) for path in paths]
+        if label_names is None:
+            label_names = _label_name_file(folder, labels)
+    elif isinstance(labels, re.Pattern):
+        values = [_name_label(folder, path, labels) for path in paths]
+    elif callable(labels):
+        values = [labels(path) for path in paths]
+    else:
+        raise TypeError(
+            "labels must be a key of the JSON file beside each motion file (str), "
+            "a compiled regular expression matched against each file's name, or a "
+            f"function of the file's path; got {type(labels).__name__} {labels!r}."
+        )
+    if label_names is None:
+        return _codes_of_distinct_values(values)
+    return _codes_of_named_values(values, _read_names(label_names), paths)
+
+
+def _json_label(path, key):
+    json_path = path.with_suffix(".json")
+    try:
+        with open(json_path, encoding="utf-8") as f:
+            content = json.load(f)
+    except FileNotFoundError:
+        raise FileNotFoundError(
+            f"{path.name} has no label file {json_path.name} beside it; labels="
+            f"{key!r} reads the label from a JSON file of the same name. Give "
+            "labels as a regular expression or a function of the path instead."
+        ) from None
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{json_path} is not valid JSON: {exc}.") from exc
+    if not isinstance(content, dict) or key not in content:
+        found = sorted(content) if isinstance(content, dict) else type(content).__name__
+        raise ValueError(f"{json_path} has no key {key!r}; it has {found}.")
+    return content[key]
+
+
+def _name_label(folder, path, pattern):
+    name = path.relative_to(folder).with_suffix("").as_posix()
+    match = pattern.search(name)
+    if match is None:
+        raise ValueError(
+            f"The file name {name!r} does not match labels={pattern.pattern!r}; "
+            "every file's name must give its label."
+        )
+    return match.group(1) if pattern.groups else match.group(0)
+
+
+def _label_name_file(folder, key):
+    for template in LABEL_NAME_FILES:
+        candidate = folder / template.format(key=key)
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _read_names(label_names):
+    if isinstance(label_names, str | os.PathLike):
+        text = Path(label_names).read_text(encoding="utf-8")
+        names = [line.strip() for line in text.splitlines() if line.strip()]
+    else:
+        names = list(label_names)
+    if not names or len(set(names)) != len(names):
+        raise ValueError(
+            f"label_names must be distinct names, at least one; got {names!r}."
+        )
+    return names
+
+
+def _codes_of_distinct_values(values):
+    try:
+        distinct = set(values)
+    except TypeError:
+        raise TypeError(
+            "Every label must be a single value (a name or a number); got "
+            f"{[v for v in values if not isinstance(v, str | Integral)][:3]}."
+        ) from None
+    try:
+        names = sorted(distinct)
+    except TypeError:
+        raise TypeError(
+            "The labels are of types that do not sort together "
+            f"({sorted({type(v).__name__ for v in values})}); give label_names."
+        ) from None
+    index = {name: code for code, name in enumerate(names)}
+    return np.array([index[v] for v in values], dtype=np.intp), _as_array(names)
+
+
+def _codes_of_named_values(values, names, paths):
+    """Codes of labels that are names, or integer indices into the names."""
+    index = {name: code for code, name in enumerate(names)}
+    codes = []
+    for value, path in zip(values, paths, strict=True):
+        if isinstance(value, Integral) and not isinstance(value, bool):
+            if not 0 <= value < len(names):
+                raise ValueError(
+                    f"{path.name} has label {value}, but there are {len(names)} "
+                    f"label names {names}."
+                )
+            codes.append(int(value))
+        elif value in index:
+            codes.append(index[value])
+        else:
+            raise ValueError(
+                f"{path.name} has label {value!r}, which is not one of the label "
+                f"names {names}."
+            )
+    return np.array(codes, dtype=np.intp), _as_array(names)
+
+
+def _as_array(names):
+    array = np.empty(len(names), dtype=object)
+    array[:] = names
+    return array
