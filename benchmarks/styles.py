@@ -100,7 +100,12 @@ import sklearn  # noqa: E402
 from sklearn.frozen import FrozenEstimator  # noqa: E402
 from sklearn.impute import KNNImputer  # noqa: E402
 
-from sklearn_crbm import ConditionalRBM, CRBMImputer  # noqa: E402
+from sklearn_crbm import (  # noqa: E402
+    ConditionalRBM,
+    CRBMImputer,
+    FactoredCRBM,
+    LabelledCRBM,
+)
 from sklearn_crbm.datasets import bone_columns, load_bandai_walks  # noqa: E402
 from sklearn_crbm.impute import AutoregressiveImputer  # noqa: E402
 from sklearn_crbm.metrics import (  # noqa: E402
@@ -159,7 +164,11 @@ class Split:
     def frames(self, rows):
         """``(Z, styles, sequence_ids)`` of the given rows."""
         walks = self.walks
-        return self.Z[rows], walks.target_names[walks.target[rows]], walks.sequence_ids[rows]
+        return (
+            self.Z[rows],
+            walks.target_names[walks.target[rows]],
+            walks.sequence_ids[rows],
+        )
 
     def takes_of(self, style, rows):
         """Sequence ids of the takes of ``style`` among ``rows``."""
@@ -382,7 +391,10 @@ class Separate(Candidate):
         for style in styles:
             estimate = _estimate(self.models[style], Z, sequence_ids, seed)[0]
             totals.append(
-                [estimate[scored & (sequence_ids == k)].sum() for k in np.unique(sequence_ids)]
+                [
+                    estimate[scored & (sequence_ids == k)].sum()
+                    for k in np.unique(sequence_ids)
+                ]
             )
         return np.asarray(styles, dtype=object)[np.argmax(totals, axis=0)]
 
@@ -394,7 +406,111 @@ class Separate(Candidate):
         return sum(_crbm_parameters(model) for model in self.models.values())
 
 
-CANDIDATES = {candidate.name: candidate for candidate in (Unlabelled, Separate)}
+class _GivenStyle:
+    """A fitted CRBMImputer that fills every sequence in one given style."""
+
+    def __init__(self, imputer, style):
+        self.imputer, self.style = imputer, style
+
+    def transform(self, X):
+        return self.imputer.transform(X, style=self.style)
+
+
+class StyleModel(Candidate):
+    """A model that takes the labels (FactoredCRBM, LabelledCRBM)."""
+
+    estimator = None
+    parameters = ()  # its fitted arrays, for the count of parameters
+
+    def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
+        model = self.estimator(random_state=seed)
+        if n_iter is not None:
+            model.set_params(n_iter=n_iter)
+        self.model = model.fit(Z, styles, sequence_ids=sequence_ids)
+        self.styles = styles
+        return self
+
+    def history_length(self):
+        return self.model.history_length
+
+    def can_generate(self, weights):
+        return True
+
+    def generate(self, weights, history, random_state):
+        return self.model.sample(
+            len(weights), history=history, style=weights, random_state=random_state
+        )
+
+    def log_likelihood(self, Z, styles, sequence_ids, seed):
+        result = self.model.estimate_log_likelihood(
+            Z, styles, sequence_ids=sequence_ids, reverse=True, random_state=seed
+        )
+        return result.log_likelihood, result.standard_error, result.lower
+
+    def recognise(self, Z, sequence_ids, styles, seed):
+        named = self.model.set_params(random_state=seed).predict(
+            Z, sequence_ids=sequence_ids
+        )
+        return np.asarray(
+            [named[sequence_ids == k][0] for k in np.unique(sequence_ids)], dtype=object
+        )
+
+    def imputer(self, style, Z, sequence_ids, seed):
+        imputer = CRBMImputer(FrozenEstimator(self.model), random_state=seed)
+        return _GivenStyle(
+            imputer.fit(Z, self.styles, sequence_ids=sequence_ids), style
+        )
+
+    def n_parameters(self):
+        return sum(
+            getattr(self.model, name).size
+            for name in self.parameters
+            if hasattr(self.model, name)
+        )
+
+
+class Factored(StyleModel):
+    """The factored CRBM: the labels gate every interaction."""
+
+    name = "factored"
+    estimator = FactoredCRBM
+    parameters = (
+        "visible_factors_",
+        "hidden_factors_",
+        "past_visible_factors_",
+        "visible_from_factors_",
+        "past_hidden_factors_",
+        "hidden_from_factors_",
+        "label_features_",
+        "style_factors_",
+        "style_undirected_",
+        "style_hidden_",
+        "style_visible_",
+        "intercept_hidden_",
+        "intercept_visible_",
+    )
+
+
+class Labelled(StyleModel):
+    """(c) A CRBM with the labels as additive inputs to its dynamic biases."""
+
+    name = "labelled"
+    estimator = LabelledCRBM
+    parameters = (
+        "components_",
+        "intercept_hidden_",
+        "intercept_visible_",
+        "autoregressive_",
+        "past_to_hidden_",
+        "label_to_visible_",
+        "label_to_hidden_",
+    )
+
+
+CANDIDATES = {
+    candidate.name: candidate
+    for candidate in (Factored, Unlabelled, Separate, Labelled)
+}
 
 
 # ----------------------------------------------------------- measurements
@@ -429,7 +545,9 @@ def judge_generated(split, frames, weights, n_sequences):
     requested = np.asarray(split.styles, dtype=object)[np.argmax(weights, axis=1)]
     blown = _blown_up(split, frames, n_sequences)
     finite = np.where(np.isfinite(frames), frames, 0.0)
-    verdict = split.judge.verdict(finite, np.tile(requested, n_sequences), sequence_ids=ids)
+    verdict = split.judge.verdict(
+        finite, np.tile(requested, n_sequences), sequence_ids=ids
+    )
     last = np.arange(len(frames)).reshape(n_sequences, n_frames)[:, -LAST_FRAMES:]
     pace = split.pace.verdict(
         finite[last.ravel()],
@@ -449,10 +567,16 @@ def style_kept(candidate, split, args, rng):
         for style in split.styles:
             weights = label_weights(split.styles, args.n_frames, style)
             history = seed_windows(
-                split, seed_style or style, candidate.history_length(), args.n_sequences, rng
+                split,
+                seed_style or style,
+                candidate.history_length(),
+                args.n_sequences,
+                rng,
             )
             frames = candidate.generate(weights, history, _draw_seed(rng))
-            verdict, pace, blown = judge_generated(split, frames, weights, args.n_sequences)
+            verdict, pace, blown = judge_generated(
+                split, frames, weights, args.n_sequences
+            )
             judged = verdict.starts >= JUDGED_FROM
             rows.setdefault(label, {})[style] = dict(
                 kept=float(verdict.correct[judged].mean()),
@@ -472,7 +596,9 @@ def blends(candidate, split, args, rng):
         weights = label_weights(split.styles, args.n_frames, first, second, blend=0.5)
         if not candidate.can_generate(weights):
             return None
-        history = seed_windows(split, NORMAL, candidate.history_length(), args.n_sequences, rng)
+        history = seed_windows(
+            split, NORMAL, candidate.history_length(), args.n_sequences, rng
+        )
         frames = candidate.generate(weights, history, _draw_seed(rng))
         blown = _blown_up(split, frames, args.n_sequences)
         frames = np.where(np.isfinite(frames), frames, 0.0)
@@ -480,16 +606,26 @@ def blends(candidate, split, args, rng):
         verdict = split.judge.verdict(frames, sequence_ids=ids)
         judged = verdict.starts >= JUDGED_FROM
         later = np.tile(np.arange(args.n_frames) >= JUDGED_FROM, args.n_sequences)
-        speed = forward_speed(frames[later], sequence_ids=ids[later], feature_names=names)
+        speed = forward_speed(
+            frames[later], sequence_ids=ids[later], feature_names=names
+        )
         frequency = step_frequency(
-            frames[later], sequence_ids=ids[later], features=split.legs, frame_rate=FRAME_RATE
+            frames[later],
+            sequence_ids=ids[later],
+            features=split.legs,
+            frame_rate=FRAME_RATE,
         )
         between = [
             _between(np.mean(value), real[first], real[second])
-            for value, real in ((speed, split.real_speed), (frequency, split.real_frequency))
+            for value, real in (
+                (speed, split.real_speed),
+                (frequency, split.real_frequency),
+            )
         ]
         cells[f"{first}/{second}"] = dict(
-            one_of_two=float(np.isin(verdict.predicted[judged], [first, second]).mean()),
+            one_of_two=float(
+                np.isin(verdict.predicted[judged], [first, second]).mean()
+            ),
             speed_between=between[0],
             frequency_between=between[1],
             blown_up=int(blown.sum()),
@@ -506,10 +642,14 @@ def transitions(candidate, split, args, rng):
     cells = {}
     switch = args.n_frames // 2
     for first, second in itertools.permutations(split.styles, 2):
-        weights = label_weights(split.styles, args.n_frames, first, second, switch=switch)
+        weights = label_weights(
+            split.styles, args.n_frames, first, second, switch=switch
+        )
         if not candidate.can_generate(weights):
             return None
-        history = seed_windows(split, first, candidate.history_length(), args.n_sequences, rng)
+        history = seed_windows(
+            split, first, candidate.history_length(), args.n_sequences, rng
+        )
         frames = candidate.generate(weights, history, _draw_seed(rng))
         verdict, _, blown = judge_generated(split, frames, weights, args.n_sequences)
         judged = verdict.starts >= switch + AFTER_SWITCH
@@ -542,7 +682,9 @@ def recognition(candidate, split, seed):
     if named is None:
         return None
     truth = [styles[ids == k][0] for k in np.unique(ids)]
-    return dict(correct=int(np.sum(named == np.asarray(truth, dtype=object))), of=len(truth))
+    return dict(
+        correct=int(np.sum(named == np.asarray(truth, dtype=object))), of=len(truth)
+    )
 
 
 def fillin(candidate, split, seed):
@@ -555,7 +697,9 @@ def fillin(candidate, split, seed):
     ]
     walks = split.walks
     held_out = {
-        walks.target_names[walks.target[walks.sequence_ids == k][0]]: walks.sequence_names[k]
+        walks.target_names[
+            walks.target[walks.sequence_ids == k][0]
+        ]: walks.sequence_names[k]
         for k in np.unique(walks.sequence_ids[split.test])
     }
     cases = make_fillin_cases(
@@ -588,7 +732,9 @@ def one_take(name, walks, args, seed, rng):
         )
         weights = label_weights(split.styles, args.n_frames, style)
         seed_style = NORMAL if candidate.controls_style else style
-        history = seed_windows(split, seed_style, candidate.history_length(), args.n_sequences, rng)
+        history = seed_windows(
+            split, seed_style, candidate.history_length(), args.n_sequences, rng
+        )
         frames = candidate.generate(weights, history, _draw_seed(rng))
         verdict, pace, blown = judge_generated(split, frames, weights, args.n_sequences)
         judged = verdict.starts >= JUDGED_FROM
@@ -608,15 +754,73 @@ def speed(candidate, split, n_frames_trained, n_iter, fit_seconds, rng):
     weights = label_weights(split.styles, 300, NORMAL)
     rates = {}
     for n_sequences in (1, 100):
-        history = seed_windows(split, NORMAL, candidate.history_length(), n_sequences, rng)
+        history = seed_windows(
+            split, NORMAL, candidate.history_length(), n_sequences, rng
+        )
         start = time.perf_counter()
         candidate.generate(weights, history, _draw_seed(rng))
         rates[n_sequences] = len(weights) * n_sequences / (time.perf_counter() - start)
-    return dict(
+    out = dict(
         seconds_per_epoch=fit_seconds / n_iter,
         training_frames_per_second=n_frames_trained * n_iter / fit_seconds,
         generation_fps_one=rates[1],
         generation_fps_per_sequence_of_100=rates[100] / 100,
+    )
+    if isinstance(candidate, StyleModel):
+        out.update(epoch_against_products(candidate, split))
+    return out
+
+
+def epoch_against_products(candidate, split, repeats=3):
+    """One training epoch's time against that of its matrix products alone.
+
+    The epoch runs once with ``numpy.matmul`` recording the shapes of every
+    product (the package's math calls it for all of them), then the same
+    products run alone on arrays of those shapes; both are timed ``repeats``
+    times (best of), one BLAS thread.
+    """
+    Z, styles, ids = split.frames(split.train)
+    Z = Z.astype(np.float32)
+    params = candidate.model.get_params()
+
+    def one_epoch():
+        model = candidate.estimator(**params)
+        model.partial_fit(Z, styles, sequence_ids=ids)
+
+    shapes, matmul = [], np.matmul
+
+    def recording(a, b, *rest, **kwargs):
+        shapes.append((a.shape, b.shape))
+        return matmul(a, b, *rest, **kwargs)
+
+    np.matmul = recording
+    try:
+        one_epoch()
+    finally:
+        np.matmul = matmul
+    rng = np.random.default_rng(0)
+    operands = [
+        (rng.random(a, dtype=np.float32), rng.random(b, dtype=np.float32))
+        for a, b in shapes
+    ]
+
+    def products():
+        for a, b in operands:
+            matmul(a, b)
+
+    timings = {}
+    for name, work in (("epoch", one_epoch), ("products", products)):
+        best = np.inf
+        for _ in range(repeats):
+            start = time.perf_counter()
+            work()
+            best = min(best, time.perf_counter() - start)
+        timings[name] = best
+    return dict(
+        epoch_seconds=timings["epoch"],
+        products_seconds=timings["products"],
+        epoch_over_products=timings["epoch"] / timings["products"],
+        n_products=len(shapes),
     )
 
 
@@ -665,7 +869,9 @@ def _mean(cells, key):
 
 
 def _likelihood(cells):
-    mean, error, gap = (_mean(cells, k) for k in ("mean", "standard_error", "reverse_gap"))
+    mean, error, gap = (
+        _mean(cells, k) for k in ("mean", "standard_error", "reverse_gap")
+    )
     return f"{mean:.2f} (SE {error:.1e}, gap {gap:.1e})"
 
 
@@ -688,7 +894,10 @@ def _speed(cells):
             "generation_fps_per_sequence_of_100",
         )
     )
-    return f"{epoch:.3f} s/epoch; {one:.0f}, {many:.0f}/seq fps"
+    text = f"{epoch:.3f} s/epoch; {one:.0f}, {many:.0f}/seq fps"
+    if "epoch_over_products" in cells[0]:
+        text += f"; epoch/products {_mean(cells, 'epoch_over_products'):.2f}"
+    return text
 
 
 # (column, part of the results, formatter of its cells over the seeds).  A
@@ -730,7 +939,10 @@ def table(results, rng):
     for name, per_seed in results.items():
         first = next(iter(per_seed.values()))
         for k, seeding in enumerate(first.get("style") or {"": None}):
-            row = [f"{name} ({seeding})" if seeding else name, str(first["n_parameters"])]
+            row = [
+                f"{name} ({seeding})" if seeding else name,
+                str(first["n_parameters"]),
+            ]
             for _, part, formatter in COLUMNS:
                 cells = _cells(per_seed, part, seeding)
                 shown = cells and (part == "style" or k == 0)
@@ -747,7 +959,11 @@ def table(results, rng):
         if row is None:
             print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
         else:
-            print("| " + " | ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)) + " |")
+            print(
+                "| "
+                + " | ".join(c.ljust(w) for c, w in zip(row, widths, strict=True))
+                + " |"
+            )
 
 
 # ------------------------------------------------------------------- main
@@ -786,7 +1002,9 @@ def main(argv=None):
     parser.add_argument(
         "--n-iter", type=int, default=None, help="epochs (default: the package's)"
     )
-    parser.add_argument("--candidates", nargs="+", default=list(CANDIDATES), choices=list(CANDIDATES))
+    parser.add_argument(
+        "--candidates", nargs="+", default=list(CANDIDATES), choices=list(CANDIDATES)
+    )
     parser.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
     parser.add_argument("--n-frames", type=int, default=1000)
     parser.add_argument("--n-sequences", type=int, default=6)

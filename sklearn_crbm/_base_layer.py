@@ -7,7 +7,7 @@ from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import _fit_context
-from sklearn.utils import check_random_state
+from sklearn.utils import Bunch, check_random_state
 from sklearn.utils._array_api import get_namespace_and_device, move_to
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import validate_data
@@ -272,6 +272,18 @@ class BaseLayerModel(BaseCRBM):
                 break
         self._layer = best_layer
         self.best_validation_score_ = best
+
+    def _estimate(self, X, sequences, context, method, reverse, random_state):
+        """``estimate_log_likelihood`` of checked input, given every frame's context."""
+        if method not in ("auto", "exact", "ais"):
+            raise ValueError(
+                f"method must be 'auto', 'exact' or 'ais', got {method!r}."
+            )
+        rng = rng_from(self.random_state if random_state is None else random_state)
+        result = self._log_likelihood(
+            X, sequences, method=method, reverse=reverse, rng=rng, context=context
+        )
+        return Bunch(**result._asdict())
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()

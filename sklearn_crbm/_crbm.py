@@ -4,7 +4,6 @@ from numbers import Integral
 
 import numpy as np
 from sklearn.externals import array_api_compat
-from sklearn.utils import Bunch
 from sklearn.utils._array_api import (
     _convert_to_numpy,
 )
@@ -16,7 +15,6 @@ from ._crbm_layer import MIN_LOG_VARIANCE, CRBMLayer
 from ._layer import BINARY
 from .utils._array_api import array_ops
 from .utils._autoregression import ridge_autoregression
-from .utils._random import rng_from
 from .utils._threads import frame_rows, limit_blas_threads
 
 # Ridge penalty of init="autoregressive": AutoregressiveImputer's default.
@@ -576,15 +574,7 @@ class ConditionalRBM(BaseLayerModel):
         >>> print(f"{result.log_likelihood.mean():.2f} {result.lower.mean():.2f}")
         -5.67 -5.67
         """
-        if method not in ("auto", "exact", "ais"):
-            raise ValueError(
-                f"method must be 'auto', 'exact' or 'ais', got {method!r}."
-            )
         X, sequences = self._check_inference_input(
             X, sequence_ids, "estimate_log_likelihood"
         )
-        rng = rng_from(self.random_state if random_state is None else random_state)
-        result = self._log_likelihood(
-            X, sequences, method=method, reverse=reverse, rng=rng
-        )
-        return Bunch(**result._asdict())
+        return self._estimate(X, sequences, None, method, reverse, random_state)

@@ -58,8 +58,12 @@ def _group(name, shape, *, decayed=True, initial=None):
     )
 
 
+# Where the hidden biases start: -1, mostly off, as the CRBM's.
+HIDDEN_BIAS_START = -1.0
+
+
 def _hidden_bias_start(layer, rng):
-    return small_normal(rng, (layer.n_components,), layer.dtype) - 1
+    return small_normal(rng, (layer.n_components,), layer.dtype) + HIDDEN_BIAS_START
 
 
 # Standard deviation of the label features' start values.
@@ -247,12 +251,6 @@ class FactoredLayer(ConditionalLayer):
     def n_lags(self):
         return self.order
 
-    def _style_weights(self):
-        """``(Z_W, Z_B, Z_A)``: one matrix three times when shared."""
-        if self.shared_style_weights:
-            return (self.style_factors,) * 3
-        return self.style_undirected, self.style_hidden, self.style_visible
-
     def style_features(self, context):
         """``z = y R`` of every frame (``context`` holds the label weights ``y``)."""
         return self.ops.matmul(context, self.label_features)
@@ -261,13 +259,17 @@ class FactoredLayer(ConditionalLayer):
         """Every factor's inputs of a batch of frames, for statistics and biases."""
         ops = self.ops
         z = self.style_features(context)
-        style_w, style_b, style_a = self._style_weights()
-        terms = {
-            "z": z,
-            "gates": ops.matmul(z, style_w),
-            "hidden_gates": ops.matmul(z, style_b),
-            "visible_gates": ops.matmul(z, style_a),
-        }
+        if self.shared_style_weights:  # one product gates every kind of factor
+            gates = ops.matmul(z, self.style_factors)
+            terms = {"z": z, "gates": gates}
+            terms["hidden_gates"] = terms["visible_gates"] = gates
+        else:
+            terms = {
+                "z": z,
+                "gates": ops.matmul(z, self.style_undirected),
+                "hidden_gates": ops.matmul(z, self.style_hidden),
+                "visible_gates": ops.matmul(z, self.style_visible),
+            }
         if self.n_lags:
             terms["hidden_past"] = ops.matmul(history, self.past_hidden_factors)
             terms["visible_past"] = ops.matmul(history, self.past_visible_factors)
@@ -390,20 +392,19 @@ class FactoredLayer(ConditionalLayer):
 
         # style features -> factors, and labels -> style features
         z = terms["z"]
-        style_w, style_b, style_a = self._style_weights()
         if self.shared_style_weights:
-            out.style_factors[...] = ops.matmul(
-                z.T, gate_statistic + hidden_gate_statistic + visible_gate_statistic
-            )
+            gate_total = gate_statistic + hidden_gate_statistic + visible_gate_statistic
+            out.style_factors[...] = ops.matmul(z.T, gate_total)
+            feature_statistic = ops.matmul(gate_total, self.style_factors.T)
         else:
             out.style_undirected[...] = ops.matmul(z.T, gate_statistic)
             out.style_hidden[...] = ops.matmul(z.T, hidden_gate_statistic)
             out.style_visible[...] = ops.matmul(z.T, visible_gate_statistic)
-        feature_statistic = (
-            ops.matmul(gate_statistic, style_w.T)
-            + ops.matmul(hidden_gate_statistic, style_b.T)
-            + ops.matmul(visible_gate_statistic, style_a.T)
-        )
+            feature_statistic = (
+                ops.matmul(gate_statistic, self.style_undirected.T)
+                + ops.matmul(hidden_gate_statistic, self.style_hidden.T)
+                + ops.matmul(visible_gate_statistic, self.style_visible.T)
+            )
         out.label_features[...] = ops.matmul(context.T, feature_statistic)
 
         out.hidden_bias[...] = ops.sum(hidden_delta, axis=0)

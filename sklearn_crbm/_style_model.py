@@ -353,6 +353,47 @@ n_classes), default=None
         log_likelihood = self._frame_log_likelihoods(X, sequences, style)
         return array_ops(X).astype(log_likelihood, X.dtype)
 
+    @limit_blas_threads(frame_rows)
+    def estimate_log_likelihood(
+        self,
+        X,
+        style,
+        *,
+        sequence_ids=None,
+        method="auto",
+        reverse=True,
+        random_state=None,
+    ):
+        """``log p(x_t | past, style)`` of every frame, with how far to trust it.
+
+        As :meth:`ConditionalRBM.estimate_log_likelihood`, given the style.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            All sequences stacked, each contiguous and in time order.
+        style : label, array-like of shape (n_frames,) or (n_frames, n_classes)
+            Every frame's style.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+        method : {"auto", "exact", "ais"}, default="auto"
+        reverse : bool, default=True
+            Also run reverse annealing (a conservative estimate).
+        random_state : int, RandomState instance or None, default=None
+            Seeds the annealing; None uses the estimator's ``random_state``.
+
+        Returns
+        -------
+        result : :class:`~sklearn.utils.Bunch`
+            ``log_likelihood``, ``lower``, ``standard_error`` and ``method``,
+            as :meth:`ConditionalRBM.estimate_log_likelihood` gives them.
+        """
+        X, sequences = self._check_inference_input(
+            X, sequence_ids, "estimate_log_likelihood"
+        )
+        context = self._as_context(self._style_weights(style, X.shape[0]), X)
+        return self._estimate(X, sequences, context, method, reverse, random_state)
+
     def fit_transform(self, X, y=None, *, sequence_ids=None):
         """Fit, then return the hidden probabilities of ``X`` given ``y``.
 
