@@ -69,9 +69,9 @@ print(
 preprocessor = make_motion_preprocessor(walks.skeleton)
 Z = preprocessor.fit_transform(walks.data, sequence_ids=walks.sequence_ids)
 print(f"root: {preprocessor.named_steps['root'].root_}, {Z.shape[1]} channels")
-model = ConditionalRBM(
-    200, order=3, n_iter=n_iter, random_state=0
-).fit(Z.astype(np.float32), sequence_ids=walks.sequence_ids)
+model = ConditionalRBM(200, order=3, n_iter=n_iter, random_state=0).fit(
+    Z.astype(np.float32), sequence_ids=walks.sequence_ids
+)
 
 # %%
 # Generate ten seconds of walking

@@ -64,9 +64,9 @@ print(f"{Z.shape[0]} frames of {Z.shape[1]} preprocessed channels")
 # --------------------------------------
 # 200 hidden units and order 3 as in the paper; about half a minute on a
 # laptop core.
-model = ConditionalRBM(
-    200, order=3, n_iter=n_iter, random_state=0
-).fit(Z.astype(np.float32), sequence_ids=motion.sequence_ids)
+model = ConditionalRBM(200, order=3, n_iter=n_iter, random_state=0).fit(
+    Z.astype(np.float32), sequence_ids=motion.sequence_ids
+)
 
 # %%
 # Generate from a walk seed and a jog seed

@@ -83,7 +83,9 @@ def test_fetch_cmu35_downloads_checks_and_skips(tmp_path, server):
     assert file_sha256(home / "cmu_subject35" / "35.asf") == CMU35_FILES[2].sha256
 
 
-def test_fetch_bandai_walks_shows_progress_and_loads(tmp_path, server, capsys, data_home):
+def test_fetch_bandai_walks_shows_progress_and_loads(
+    tmp_path, server, capsys, data_home
+):
     base_url, _, requests = server
     home = tmp_path / "home"
     assert fetch_bandai_walks(home, base_url=base_url) == home
@@ -168,18 +170,26 @@ def test_bandai_urls_are_those_of_the_provenance_file(data_home):
     provenance = {}
     for line in (folder / "PROVENANCE.tsv").read_text().splitlines():
         filename, repository, path, commit = line.split("\t")
-        provenance[filename] = f"https://raw.githubusercontent.com/{repository}/{commit}/{path}"
+        provenance[filename] = (
+            f"https://raw.githubusercontent.com/{repository}/{commit}/{path}"
+        )
     remotes = {remote.filename: remote for remote in BANDAI_WALK_FILES}
     assert sorted(remotes) == sorted(
-        p.name for p in folder.iterdir() if p.name not in ("README.md", "PROVENANCE.tsv")
+        p.name
+        for p in folder.iterdir()
+        if p.name not in ("README.md", "PROVENANCE.tsv")
     )
     for filename, url in provenance.items():
         assert remotes[filename].url() == url
         json_url = remotes[filename.replace(".bvh", ".json")].url()
         assert json_url == url.replace(".bvh", ".json")
-    assert remotes["style_label.txt"].url().endswith(
-        "/74ead3ba1ae4696404e6086233779f60de8bf9ef/dataset/"
-        "Bandai-Namco-Research-Motiondataset-2/cfg/style_label.txt"
+    assert (
+        remotes["style_label.txt"]
+        .url()
+        .endswith(
+            "/74ead3ba1ae4696404e6086233779f60de8bf9ef/dataset/"
+            "Bandai-Namco-Research-Motiondataset-2/cfg/style_label.txt"
+        )
     )
     for filename, remote in remotes.items():
         assert file_sha256(folder / filename) == remote.sha256, filename

@@ -101,13 +101,17 @@ def test_the_label_names_are_found_in_the_repositorys_cfg_folder(
             shutil.copyfile(
                 styles_folder / (name + suffix), tmp_path / "data" / (name + suffix)
             )
-    shutil.copyfile(styles_folder / "style_label.txt", tmp_path / "cfg" / "style_label.txt")
+    shutil.copyfile(
+        styles_folder / "style_label.txt", tmp_path / "cfg" / "style_label.txt"
+    )
     shutil.copyfile(
         styles_folder / "content_label.txt", tmp_path / "cfg" / "content_label.txt"
     )
     walks = read_bvh_folder(tmp_path / "data", labels="style")
     assert len(walks.target_names) == 7
-    assert [walks.target_names[walks.target[walks.sequence_ids == k][0]] for k in (0, 1)] == [
+    assert [
+        walks.target_names[walks.target[walks.sequence_ids == k][0]] for k in (0, 1)
+    ] == [
         "dataset-2_elderly",
         "dataset-2_youthful",
     ]

@@ -119,9 +119,12 @@ def test_windows_cover_every_frame_and_the_end(sine_judge):
     assert_allclose(window_proba, verdict.proba)
     # a frame's probabilities are the mean over the windows that hold it
     frame_proba = judge.predict_proba(X2, sequence_ids=short_ids)
-    first = np.concatenate(([0], np.cumsum([130])))[
-        np.searchsorted([4, 9], verdict.sequence_ids)
-    ] + verdict.starts
+    first = (
+        np.concatenate(([0], np.cumsum([130])))[
+            np.searchsorted([4, 9], verdict.sequence_ids)
+        ]
+        + verdict.starts
+    )
     for frame in range(len(X2)):
         holding = (first <= frame) & (frame < first + 60)
         assert_allclose(frame_proba[frame], window_proba[holding].mean(axis=0))
