@@ -3,7 +3,8 @@
 One definition of "erase from half-way" for the whole package: frame ``i``
 of a sequence of ``n`` frames is erased when ``start <= i / n < stop``.  The
 imputation scorer, the command line, the benchmarks and the documentation
-all build their masks with :func:`erasure_mask`.
+all build their masks with :func:`erasure_mask`, and
+:func:`compare_imputers` scores imputers on the paper's cases.
 """
 
 from functools import partial
@@ -17,7 +18,12 @@ from ..datasets import bone_columns
 from ..metrics import fillin_angle_rmse, fillin_error
 from ..utils._sequences import check_sequence_ids
 
-__all__ = ["erasure_mask", "make_fillin_cases", "paper_body_parts"]
+__all__ = [
+    "compare_imputers",
+    "erasure_mask",
+    "make_fillin_cases",
+    "paper_body_parts",
+]
 
 # The paper's test trials (§4.4): the held-out walk and jog of CMU subject 35.
 PAPER_TRIALS = {"walk": "35_29", "jog": "35_18"}
@@ -398,3 +404,96 @@ def _case_errors(case, preprocessor, X_filled):
         fillin_error(case.X, X_filled, missing_mask=case.missing_mask),
         fillin_angle_rmse(case.raw, raw, missing_mask=case.raw_missing_mask),
     )
+
+
+def compare_imputers(imputers, cases, *, n_repeats=None, random_state=None):
+    """Score fitted imputers on fill-in cases: the paper's error and degrees.
+
+    Every imputer fills ``X_missing`` of every case of
+    :func:`make_fillin_cases`, and the fill is scored with the case's
+    ``errors``: the paper's error (:func:`~sklearn_crbm.metrics.fillin_error`)
+    and the RMS error of the erased joint angles in degrees
+    (:func:`~sklearn_crbm.metrics.fillin_angle_rmse`).  An imputer that
+    draws fills (one with ``sample``, such as
+    :class:`~sklearn_crbm.CRBMImputer`) is scored, with ``n_repeats``, by
+    the mean error of that many single draws, as in the paper's §4.4;
+    the others fill once with ``transform``.
+
+    Parameters
+    ----------
+    imputers : dict
+        ``{name: imputer}``, each fitted on data in the space of the cases'
+        ``X`` (for example ``KNNImputer``,
+        :class:`~sklearn_crbm.impute.NearestNeighborImputer`,
+        :class:`~sklearn_crbm.impute.AutoregressiveImputer`,
+        :class:`~sklearn_crbm.CRBMImputer`).
+    cases : dict
+        ``{key: case}`` from :func:`make_fillin_cases`.
+    n_repeats : int, default=None
+        Single draws averaged per case for imputers with ``sample``.  None
+        fills once with every imputer's ``transform`` (a ``CRBMImputer``
+        then averages its ``n_draws`` fills into one).
+    random_state : int, RandomState instance or None, default=None
+        Seeds the draws of ``sample``, the same for every case.
+
+    Returns
+    -------
+    scores : dict
+        ``{name: {key: {"error": float, "angle_rmse": float}}}``, in the
+        order of ``imputers`` and ``cases``.
+
+    See Also
+    --------
+    make_fillin_cases : The cases.
+    make_imputation_scorer : A fill-in error as a scorer for a grid search.
+
+    Examples
+    --------
+    >>> from sklearn.impute import KNNImputer
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> from sklearn_crbm.impute import NearestNeighborImputer
+    >>> from sklearn_crbm.model_selection import compare_imputers, make_fillin_cases
+    >>> from sklearn_crbm.preprocessing import make_motion_preprocessor
+    >>> walker = make_walker(n_sequences=3, n_frames=41, random_state=0)
+    >>> train = walker.sequence_ids < 2
+    >>> preprocessor = make_motion_preprocessor(walker.skeleton)
+    >>> Z = preprocessor.fit_transform(walker.data[train])
+    >>> cases = make_fillin_cases(walker, preprocessor, trials={"walk": "walk_2"})
+    >>> scores = compare_imputers(
+    ...     {"NN": NearestNeighborImputer().fit(Z),
+    ...      "KNN(5)": KNNImputer(n_neighbors=5).fit(Z)}, cases)
+    >>> sorted(scores["NN"])
+    [('walk', 'left leg'), ('walk', 'upper body')]
+    >>> sorted(scores["NN"]["walk", "left leg"])
+    ['angle_rmse', 'error']
+    """
+    if not isinstance(imputers, dict) or not imputers:
+        raise TypeError(
+            "imputers must be a non-empty dict {name: fitted imputer}, got "
+            f"{type(imputers).__name__}."
+        )
+    if n_repeats is not None and (
+        isinstance(n_repeats, bool)
+        or not isinstance(n_repeats, Integral)
+        or n_repeats < 1
+    ):
+        raise ValueError(f"n_repeats must be None or an int >= 1, got {n_repeats!r}.")
+    return {
+        name: {
+            key: _case_scores(imputer, case, n_repeats, random_state)
+            for key, case in cases.items()
+        }
+        for name, imputer in imputers.items()
+    }
+
+
+def _case_scores(imputer, case, n_repeats, random_state):
+    """``{"error", "angle_rmse"}`` of one imputer's fill of one case."""
+    if n_repeats is not None and hasattr(imputer, "sample"):
+        draws = imputer.sample(
+            case.X_missing, n_samples=n_repeats, random_state=random_state
+        )
+        error, degrees = np.mean([case.errors(draw) for draw in draws], axis=0)
+    else:
+        error, degrees = case.errors(imputer.transform(case.X_missing))
+    return {"error": float(error), "angle_rmse": float(degrees)}

@@ -3,17 +3,21 @@
 Raw channels (Euler angles, root position) -> :class:`ExpMapEncoder` ->
 :class:`RootRelativeEncoder` -> :class:`StandardScaler`; every step has an
 exact ``inverse_transform``.  :func:`make_motion_preprocessor` builds the
-chain for a skeleton.
+chain for a skeleton, :func:`make_motion_pipeline` the chain and a model in
+a :class:`MotionPipeline`, which generates raw channels and writes them as
+BVH or AMC files.
 """
 
 from ._data import StandardScaler
 from ._expmap import ExpMapEncoder
-from ._pipeline import make_motion_preprocessor
+from ._pipeline import MotionPipeline, make_motion_pipeline, make_motion_preprocessor
 from ._root import RootRelativeEncoder
 
 __all__ = [
     "ExpMapEncoder",
+    "MotionPipeline",
     "RootRelativeEncoder",
     "StandardScaler",
+    "make_motion_pipeline",
     "make_motion_preprocessor",
 ]

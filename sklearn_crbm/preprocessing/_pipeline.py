@@ -1,13 +1,20 @@
-"""The paper's preprocessing chain as one Pipeline."""
+"""The paper's preprocessing chain as one Pipeline, and models on top of it."""
 
+from pathlib import Path
+
+import numpy as np
 import sklearn
 from sklearn.pipeline import Pipeline
+from sklearn.utils.metaestimators import available_if
 
+from ..datasets import write_amc, write_bvh
+from ..metrics import forward_speed
+from ..utils import random_windows
 from ._data import StandardScaler
 from ._expmap import ExpMapEncoder
 from ._root import RootRelativeEncoder
 
-__all__ = ["make_motion_preprocessor"]
+__all__ = ["MotionPipeline", "make_motion_pipeline", "make_motion_preprocessor"]
 
 
 def _check_routing(params):
@@ -23,8 +30,65 @@ def _check_routing(params):
         )
 
 
+def _has_sampler(pipeline):
+    """Whether the final step is a generative model (for ``available_if``)."""
+    return hasattr(pipeline._final_estimator, "sample")
+
+
 class MotionPipeline(Pipeline):
-    """A Pipeline whose ``fit`` explains metadata routing when it is off."""
+    """A :class:`~sklearn.pipeline.Pipeline` of motion preprocessing and a model.
+
+    The steps are the motion preprocessing (every step has an exact
+    ``inverse_transform``: see :func:`make_motion_preprocessor`), optionally
+    followed by a generative sequence model such as
+    :class:`~sklearn_crbm.ConditionalRBM` (see :func:`make_motion_pipeline`).
+    It is a scikit-learn Pipeline in every other respect (cloning, slicing,
+    metadata routing of ``sequence_ids``, grid searches, pickling); what it
+    adds works in the units of the raw channels:
+
+    - :meth:`sample` generates with the model and returns raw channels;
+    - :meth:`write_motion` writes raw channels as a BVH or AMC file;
+    - :meth:`style_windows` picks seeds of a chosen style for :meth:`sample`;
+    - :meth:`forward_speed` measures preprocessed motion in the skeleton's
+      length units.
+
+    Its ``fit`` and ``fit_transform`` say how to turn metadata routing on if
+    ``sequence_ids`` is passed without it.
+
+    Parameters
+    ----------
+    steps : list of (str, estimator) tuples
+        As for :class:`~sklearn.pipeline.Pipeline`.
+    transform_input, memory, verbose
+        As for :class:`~sklearn.pipeline.Pipeline`.
+
+    Attributes
+    ----------
+    skeleton : Skeleton
+        The skeleton of the raw channels (that of the first step that has
+        one).
+
+    See Also
+    --------
+    make_motion_pipeline : Preprocessing and a model in one pipeline.
+    make_motion_preprocessor : The preprocessing alone.
+
+    Examples
+    --------
+    >>> import sklearn
+    >>> from sklearn_crbm import ConditionalRBM
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> from sklearn_crbm.preprocessing import make_motion_pipeline
+    >>> walker = make_walker(n_sequences=2, n_frames=40, random_state=0)
+    >>> model = ConditionalRBM(8, order=2, n_iter=2, random_state=0)
+    >>> pipe = make_motion_pipeline(walker.skeleton, model)
+    >>> with sklearn.config_context(enable_metadata_routing=True):
+    ...     pipe = pipe.fit(walker.data, sequence_ids=walker.sequence_ids)
+    >>> raw = pipe.sample(25, n_sequences=2, random_state=0)
+    >>> raw.shape  # two sequences of 25 frames, in the skeleton's channels
+    (50, 33)
+    >>> pipe.write_motion("walk.bvh", raw[:25], frame_rate=30.0)  # doctest: +SKIP
+    """
 
     def fit(self, X, y=None, **params):
         _check_routing(params)
@@ -33,6 +97,259 @@ class MotionPipeline(Pipeline):
     def fit_transform(self, X, y=None, **params):
         _check_routing(params)
         return super().fit_transform(X, y, **params)
+
+    @property
+    def skeleton(self):
+        for _, step in self.steps:
+            if hasattr(step, "skeleton"):
+                return step.skeleton
+        raise AttributeError(f"No step of {type(self).__name__} has a skeleton.")
+
+    def _preprocessor(self):
+        """The preprocessing steps: all but a final generative model."""
+        return self[:-1] if _has_sampler(self) else self
+
+    @available_if(_has_sampler)
+    def sample(
+        self, n_frames, *, history=None, n_sequences=1, random_state=None, **params
+    ):
+        """Generate motion with the final model, as raw channels.
+
+        The model generates in the space it was trained in (its ``sample``);
+        the preprocessing steps' ``inverse_transform`` brings every
+        generated sequence back to the skeleton's raw channels (each starts
+        at heading 0 and ground position (0, 0): see
+        :class:`RootRelativeEncoder`).
+
+        Parameters
+        ----------
+        n_frames : int
+            Frames generated per sequence.
+        history : array-like, default=None
+            Seed frames in the model's space (the output of the preprocessing
+            steps), as the model's ``sample`` takes them, for example from
+            :meth:`style_windows`.  ``None``: the model's own seed windows
+            of real training frames.
+        n_sequences : int, default=1
+            Sequences to generate.
+        random_state : int, RandomState instance or None, default=None
+            Seeds the generation.
+        **params : dict
+            Passed on to the model's ``sample`` (for a
+            :class:`~sklearn_crbm.ConditionalRBM`: ``n_gibbs``,
+            ``hidden_noise``, ``sample_visibles``, ``n_jobs``).
+
+        Returns
+        -------
+        X_raw : ndarray of shape (n_sequences * n_frames, n_raw_features)
+            The generated frames in long format, in the skeleton's channels
+            (``skeleton.feature_names``): rows ``k * n_frames`` to
+            ``(k + 1) * n_frames - 1`` are sequence ``k``.
+        """
+        frames = self._final_estimator.sample(
+            n_frames,
+            history=history,
+            n_sequences=n_sequences,
+            random_state=random_state,
+            **params,
+        )
+        n_sequences = frames.shape[0] // n_frames
+        sequence_ids = np.repeat(np.arange(n_sequences), n_frames)
+        with sklearn.config_context(enable_metadata_routing=True):
+            return self[:-1].inverse_transform(
+                np.asarray(frames), sequence_ids=sequence_ids
+            )
+
+    @available_if(_has_sampler)
+    def style_windows(
+        self, X, y, *, sequence_ids=None, n_windows=50, random_state=None
+    ):
+        """Windows of real frames of every style, to seed :meth:`sample`.
+
+        ``X`` (raw channels) goes through the preprocessing steps; each
+        window is ``max(history_length, 1)`` consecutive frames of one
+        sequence that all have the same label, drawn as
+        :func:`~sklearn_crbm.utils.random_windows` draws them.  Pass
+        ``windows[style]`` as ``history`` to :meth:`sample` to generate from
+        real motion of that style, as the paper's first demonstration does
+        (§4.1: walking and jogging from one model).
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_raw_features)
+            Real motion in raw channels, for example the training data.
+        y : array-like of shape (n_frames,)
+            The style (any label) of every frame.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Sequence id of every frame; ``None`` means one sequence.
+        n_windows : int, default=50
+            Windows per style.
+        random_state : int, numpy.random.Generator or None, default=None
+            Seeds the draws (the styles are drawn in turn from one stream).
+
+        Returns
+        -------
+        windows : dict
+            ``{style: ndarray of shape (n_windows, width, n_features)}`` in
+            the model's space, oldest frame first, the styles in order of
+            first appearance.
+
+        Raises
+        ------
+        ValueError
+            If a style has no run of ``width`` frames within one sequence.
+        """
+        y = np.asarray(y, dtype=object)
+        if y.shape != (len(X),):
+            raise ValueError(
+                f"y must hold one style per frame: {len(X)} labels, got shape "
+                f"{y.shape}."
+            )
+        params = {} if sequence_ids is None else {"sequence_ids": sequence_ids}
+        _check_routing(params)
+        Z = self[:-1].transform(X, **params)
+        runs = _label_runs(sequence_ids, y)
+        width = max(self._final_estimator.history_length, 1)
+        rng = np.random.default_rng(random_state)
+        windows = {}
+        for style in dict.fromkeys(y.tolist()):
+            windows[style] = random_windows(
+                Z,
+                sequence_ids=runs,
+                width=width,
+                n_windows=n_windows,
+                sequences=np.unique(runs[y == style]),
+                random_state=rng,
+            )
+        return windows
+
+    def forward_speed(self, X, *, sequence_ids=None, last_frames=None):
+        """Forward speed of preprocessed motion, in the skeleton's length units.
+
+        ``X`` is the output of the preprocessing steps (the model's space,
+        where the speed channel is standardised); the steps after the
+        :class:`RootRelativeEncoder` are undone, and
+        :func:`~sklearn_crbm.metrics.forward_speed` measures its
+        ``{root}_dforward`` channel: the mean distance the body moves
+        forward per frame, in the length units of the skeleton's file.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            Motion in the space the preprocessing steps output.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Sequence id of every frame; ``None`` means one sequence.
+        last_frames : int, default=None
+            Use only the last ``last_frames`` frames of each sequence.
+
+        Returns
+        -------
+        speed : ndarray of shape (n_sequences,)
+            Length units per frame.
+        """
+        preprocessor = self._preprocessor()
+        encoders = [
+            k
+            for k, (_, step) in enumerate(preprocessor.steps)
+            if isinstance(step, RootRelativeEncoder)
+        ]
+        if not encoders:
+            raise ValueError(
+                "forward_speed needs a RootRelativeEncoder step, which measures "
+                "the body's forward displacement; this pipeline has the steps "
+                f"{[name for name, _ in preprocessor.steps]}."
+            )
+        root = encoders[-1]
+        after = preprocessor[root + 1 :]
+        unscaled = after.inverse_transform(X) if len(after) else X
+        return forward_speed(
+            unscaled,
+            sequence_ids=sequence_ids,
+            feature_names=preprocessor[: root + 1].get_feature_names_out(),
+            last_frames=last_frames,
+        )
+
+    def write_motion(self, path, X, *, frame_rate=None):
+        """Write one sequence of raw channels as a BVH or AMC file.
+
+        The format follows the file's suffix: ``.bvh`` writes
+        :func:`~sklearn_crbm.datasets.write_bvh`, ``.amc``
+        :func:`~sklearn_crbm.datasets.write_amc` (for a skeleton read from
+        an ASF file, which the AMC file goes with).
+
+        Parameters
+        ----------
+        path : path-like
+            The file, ending in ``.bvh`` or ``.amc``.
+        X : array-like of shape (n_frames, n_raw_features)
+            One sequence in the skeleton's channels, for example one
+            sequence of :meth:`sample`.
+        frame_rate : float, default=None
+            Frames per second, required for BVH (AMC files do not say).
+        """
+        suffix = Path(path).suffix.lower()
+        if suffix == ".bvh":
+            if frame_rate is None:
+                raise ValueError(
+                    "A BVH file says its frame rate: pass frame_rate= (the "
+                    "training data's, e.g. load_cmu35(...).frame_rate)."
+                )
+            write_bvh(path, X, self.skeleton, frame_rate)
+        elif suffix == ".amc":
+            write_amc(path, X, self.skeleton)
+        else:
+            raise ValueError(
+                f"Cannot tell the format of {path}: name it *.bvh or *.amc."
+            )
+
+
+def _label_runs(sequence_ids, y):
+    """Ids of the runs of frames with one label within one sequence."""
+    ids = np.zeros(len(y), dtype=np.intp) if sequence_ids is None else sequence_ids
+    ids = np.asarray(ids)
+    new_run = np.ones(len(y), dtype=bool)
+    new_run[1:] = (ids[1:] != ids[:-1]) | (y[1:] != y[:-1])
+    return np.cumsum(new_run) - 1
+
+
+def make_motion_pipeline(skeleton, model, **preprocessor_params):
+    """The paper's preprocessing followed by a generative model, as one pipeline.
+
+    The steps of :func:`make_motion_preprocessor` (``expmap``, ``root``,
+    ``scale``) then ``model``, named ``"model"``, in a
+    :class:`MotionPipeline`: ``fit`` preprocesses and trains on raw
+    channels, :meth:`MotionPipeline.sample` generates raw channels, and
+    :meth:`MotionPipeline.write_motion` writes them as BVH or AMC.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+        Describes the raw columns, as for :func:`make_motion_preprocessor`.
+    model : estimator
+        The model, trained on the preprocessed motion, for example a
+        :class:`~sklearn_crbm.ConditionalRBM`; with a ``sample`` method the
+        pipeline can generate.
+    **preprocessor_params : dict
+        Passed to :func:`make_motion_preprocessor` (``reference``, ``roll``,
+        ``up_axis``...).
+
+    Returns
+    -------
+    pipeline : MotionPipeline
+        Unfitted.
+
+    Examples
+    --------
+    >>> from sklearn_crbm import ConditionalRBM
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> from sklearn_crbm.preprocessing import make_motion_pipeline
+    >>> walker = make_walker(n_sequences=1, n_frames=10, random_state=0)
+    >>> pipe = make_motion_pipeline(walker.skeleton, ConditionalRBM(8))
+    >>> [name for name, _ in pipe.steps]
+    ['expmap', 'root', 'scale', 'model']
+    """
+    preprocessor = make_motion_preprocessor(skeleton, **preprocessor_params)
+    return MotionPipeline([*preprocessor.steps, ("model", model)])
 
 
 def make_motion_preprocessor(
@@ -105,7 +422,7 @@ def make_motion_preprocessor(
 
     Returns
     -------
-    pipeline : sklearn.pipeline.Pipeline
+    pipeline : MotionPipeline
         Unfitted; ``get_feature_names_out()`` names every output channel
         once fitted.  Its ``fit`` and ``fit_transform`` say how to turn
         metadata routing on if ``sequence_ids`` is passed without it.
