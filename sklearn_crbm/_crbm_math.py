@@ -427,7 +427,7 @@ class CRBMParameters:
         learned_variance=False,
         fixed_variance=False,
     ):
-        """The original code's initialisation (REFERENCE.md).
+        """The original code's initialisation (its ``gaussiancrbm.m``).
 
         ``W``, ``A``, ``B`` and the visible bias are N(0, 0.01^2); the hidden
         bias is -1 + N(0, 0.01^2) so that hidden units start mostly off;
@@ -1112,7 +1112,7 @@ def gibbs_frames(
 ):
     """Alternating Gibbs sampling of new frames given their dynamic biases.
 
-    The original generation scheme (REFERENCE.md, ``gen.m``): ``n_gibbs``
+    The original generation scheme (the original code's ``gen.m``): ``n_gibbs``
     iterations in which the hidden units are sampled and the visibles set to
     their mean, then one final mean-field step with hidden probabilities.
     ``hidden_noise`` adds N(0, hidden_noise^2) to the hidden biases each time
