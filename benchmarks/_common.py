@@ -1,138 +1,110 @@
-"""Helpers shared by the speed and memory benchmarks (``bench_*.py``).
+"""What the benchmark scripts share; not part of the package.
 
-Timing, the matrix-multiply peak of this machine, FLOP counts of one CD epoch,
-the paper's data (with a synthetic stand-in of the same shape when the data
-is missing), tables and JSON.  Not part of the package.
+Options and paths, the package under test and the machine, data (the splits
+of CMU subject 35, synthetic motion), one cache of fitted models keyed on the
+package's code, the bootstrap of a mean over training seeds, timing, tables
+and JSON.  The scripts import this module and the package's public API, and
+nothing else of the package: the one exception, the matrix products of a
+training epoch timed on their own, is marked below.
+
+The package under test is the one Python imports: set ``PYTHONPATH`` to
+another checkout to measure its code with these scripts (every script prints
+which one it measures, and writes it into its JSON).
 """
 
+import argparse
+import ast
+import hashlib
 import json
 import os
 import platform
 import statistics
+import subprocess
 import sys
 import time
 from contextlib import contextmanager
 from pathlib import Path
 
+import joblib
 import numpy as np
 import sklearn
 import threadpoolctl
-from threadpoolctl import threadpool_info
+from sklearn.frozen import FrozenEstimator
+from sklearn.impute import KNNImputer
 
 import sklearn_crbm
+from sklearn_crbm import ConditionalRBM
+from sklearn_crbm.datasets import load_cmu35, load_mit_walk
+from sklearn_crbm.impute import (
+    AutoregressiveImputer,
+    CRBMImputer,
+    NearestNeighborImputer,
+)
+from sklearn_crbm.metrics import judge_generated_motion
+from sklearn_crbm.model_selection import compare_imputers, make_fillin_cases
+from sklearn_crbm.preprocessing import MotionPipeline, make_motion_preprocessor
 
 REPO = Path(__file__).resolve().parents[1]
 RESULTS = REPO / "benchmarks" / "results"
-DEFAULT_DATA_HOME = REPO.parent / "shared" / "data"
+DATA_HOME = os.environ.get("SKLEARN_CRBM_DATA", str(REPO.parent / "shared" / "data"))
+CACHE = Path(os.environ.get("SKLEARN_CRBM_BENCH_CACHE", RESULTS / "cache"))
+PACKAGE = Path(sklearn_crbm.__file__).resolve().parent
 
-# The paper's configuration (CMU 35 after preprocessing).
+# The paper's model on CMU subject 35 after preprocessing (62 channels).
 PAPER = dict(n_features=62, n_components=200, order=3, batch_size=100)
-CMU_TRAIN_FRAMES, CMU_TRAIN_SEQUENCES = 2644, 31
+
+# CMU 35 train/test splits: one walk and one jog held out.  "paper" is the
+# paper's §4.4 split; "second" holds out trials of similar lengths.
+SPLITS = {"paper": ("35_29", "35_18"), "second": ("35_05", "35_22")}
+CELLS = ("walk/leg", "walk/upper", "jog/leg", "jog/upper")
+# The paper's joint encoding (rest-pose reference, Taylor's root roll), in
+# which the quality tables are measured.
+PAPER_ENCODING = dict(reference="rest", roll="taylor")
 
 
-def add_common_arguments(parser):
-    parser.add_argument(
-        "--data-home",
-        default=os.environ.get("SKLEARN_CRBM_DATA", str(DEFAULT_DATA_HOME)),
-        help="folder holding the mocap data (default: ../shared/data)",
+def parser(doc, seeds=(0, 1, 2, 3, 4)):
+    """An argument parser with the options every script has."""
+    p = argparse.ArgumentParser(
+        description=doc.split("\n")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument(
-        "--repeats", type=int, default=5, help="timed repetitions (best and median)"
-    )
-    parser.add_argument(
-        "--threads", type=int, nargs="+", default=[1, 2], help="BLAS thread counts"
-    )
-    parser.add_argument(
-        "--dtypes", nargs="+", default=["float64", "float32"], help="dtypes to run"
-    )
-    parser.add_argument("--output", default=None, help="JSON file to write")
-    return parser
+    p.add_argument("--data-home", default=DATA_HOME, help="the mocap data folder")
+    p.add_argument("--output", default=None, help="JSON file to write")
+    if seeds is not None:
+        p.add_argument("--seeds", type=int, nargs="+", default=list(seeds))
+    return p
 
 
-# ------------------------------------------------------------------ timing
+def speed_parser(doc, threads=(1, 2)):
+    """The parser of the speed benchmarks: repeats, BLAS threads and dtypes too."""
+    p = parser(doc, seeds=None)
+    p.add_argument("--repeats", type=int, default=5, help="timed repetitions")
+    p.add_argument("--threads", type=int, nargs="+", default=list(threads))
+    p.add_argument("--dtypes", nargs="+", default=["float64", "float32"])
+    return p
 
 
-@contextmanager
-def threadpool_limits(threads):
-    """``threads`` BLAS threads, for the libraries and the package's loops alike.
-
-    The package picks its own thread count inside its methods
-    (``sklearn_crbm.set_config``); a benchmark row that says 2 threads must
-    run them with 2.
-    """
-    with (
-        threadpoolctl.threadpool_limits(threads),
-        sklearn_crbm.config_context(blas_threads=threads),
-    ):
-        yield
+# -------------------------------------------------------- package, machine
 
 
-def time_call(func, repeats, timer=time.perf_counter):
-    """Run ``func`` ``repeats`` times; return the list of durations (seconds)."""
-    times = []
-    for _ in range(repeats):
-        start = timer()
-        func()
-        times.append(timer() - start)
-    return times
+def package_description():
+    """Where the package under test lives and which commit it is."""
+    try:
+        commit = subprocess.run(
+            ["git", "-C", str(PACKAGE), "describe", "--always", "--dirty"],
+            capture_output=True,
+            text=True,
+            timeout=30,
+        ).stdout.strip()
+    except OSError:
+        commit = ""
+    return {"path": str(PACKAGE), "commit": commit or "unknown"}
 
 
-def summary(times):
-    return {"best": min(times), "median": statistics.median(times), "all": times}
-
-
-def time_both(func):
-    """Wall-clock and process CPU seconds of one call of ``func``.
-
-    With one BLAS thread the CPU time leaves out the time the process waited
-    for a core, which makes it the steadier measure on a shared machine.
-    """
-    wall, cpu = time.perf_counter(), time.process_time()
-    func()
-    return time.perf_counter() - wall, time.process_time() - cpu
-
-
-def gemm_peak(dtype, n=2000, repeats=3, clock="wall"):
-    """GFLOP/s of one large ``n x n`` matrix product (best of ``repeats``).
-
-    Run it under the same ``threadpool_limits`` as what it is compared with.
-    ``clock="both"`` returns ``(wall_gflops, cpu_gflops)``.
-    """
-    rng = np.random.default_rng(0)
-    a = rng.standard_normal((n, n)).astype(dtype)
-    b = rng.standard_normal((n, n)).astype(dtype)
-    out = np.empty((n, n), dtype)
-    np.matmul(a, b, out=out)  # warm up
-    times = [time_both(lambda: np.matmul(a, b, out=out)) for _ in range(repeats)]
-    wall, cpu = (2.0 * n**3 / min(t) / 1e9 for t in zip(*times, strict=True))
-    return (wall, cpu) if clock == "both" else wall
-
-
-def cd_epoch_flops(n_train_frames, n_features, n_components, order, cd_steps=1):
-    """FLOPs of the matrix products of one CD-k epoch (2 m n k per product).
-
-    Per frame: the dynamic biases (history x [A; B]), the positive hidden
-    input (v W^T), per step the reconstruction (h W) and the negative hidden
-    input (v_recon W^T), the W statistics (two products) and the directed
-    statistics ([v - v_recon, h_data - h_recon]^T x history).  Elementwise
-    work, random numbers and updates are not counted.
-    """
-    d, h, k = n_features, n_components, order * n_features
-    per_frame = 2 * (
-        k * (d + h) + d * h + cd_steps * 2 * d * h + 2 * d * h + (d + h) * k
-    )
-    return per_frame * n_train_frames
-
-
-def blas_description():
-    info = threadpool_info()
-    return [
-        {
-            k: entry.get(k)
-            for k in ("internal_api", "version", "architecture", "num_threads")
-        }
-        for entry in info
-    ]
+def announce():
+    """Print the package under test (the first line of every script's output)."""
+    info = package_description()
+    print(f"sklearn_crbm from {info['path']} at {info['commit']}", flush=True)
 
 
 def machine():
@@ -143,7 +115,10 @@ def machine():
         "python": sys.version.split()[0],
         "numpy": np.__version__,
         "scikit-learn": sklearn.__version__,
-        "blas": blas_description(),
+        "blas": [
+            {k: e.get(k) for k in ("internal_api", "version", "num_threads")}
+            for e in threadpoolctl.threadpool_info()
+        ],
         "load_average": os.getloadavg(),
         "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
     }
@@ -162,16 +137,110 @@ def _cpu_name():
 # -------------------------------------------------------------------- data
 
 
+class Split:
+    """One split of CMU subject 35: training trials and the erased test cases.
+
+    The preprocessing (the paper's encoding) is fitted on the training trials.
+    ``cases`` maps ``"walk/leg"`` ... ``"jog/upper"`` to the cases of
+    :func:`~sklearn_crbm.model_selection.make_fillin_cases`: the left leg or
+    the upper body of a held-out trial erased from half-way to the end.
+    ``X_test``/``test_ids`` are the two held-out trials, walk first.
+    """
+
+    def __init__(self, data_home, name):
+        self.cmu = cmu = load_cmu35(data_home)
+        walk, jog = self.trials = SPLITS[name]
+        names = list(cmu.sequence_names)
+        held_out = np.isin(cmu.sequence_ids, [names.index(walk), names.index(jog)])
+        self.name = name
+        self.train_ids = cmu.sequence_ids[~held_out]
+        self.preprocessor = make_motion_preprocessor(cmu.skeleton, **PAPER_ENCODING)
+        with sklearn.config_context(enable_metadata_routing=True):
+            self.X_train = self.preprocessor.fit_transform(
+                cmu.data[~held_out], sequence_ids=self.train_ids
+            )
+        cases = make_fillin_cases(
+            cmu, self.preprocessor, trials={"walk": walk, "jog": jog}
+        )
+        parts = {"left leg": "leg", "upper body": "upper"}
+        self.cases = {f"{m}/{parts[p]}": case for (m, p), case in cases.items()}
+        walk_X, jog_X = self.cases["walk/leg"].X, self.cases["jog/leg"].X
+        self.X_test = np.concatenate([walk_X, jog_X])
+        self.test_ids = np.repeat([0, 1], [len(walk_X), len(jog_X)])
+
+
+class MotionCorpus:
+    """Real motion of known styles, preprocessed, with the judge of generated motion.
+
+    ``name`` is ``"cmu"`` (all 33 trials of CMU subject 35, walks and jogs)
+    or ``"mit"`` (Taylor's MIT walks); ``encoding`` holds parameters of
+    ``make_motion_preprocessor``.  ``real`` gives the mean leg amplitude and
+    step frequency of the real sequences of each style.
+    """
+
+    LEGS = {
+        "cmu": ("lfemur", "rfemur", "ltibia", "rtibia"),
+        "mit": ("lhip", "rhip", "lknee", "rknee"),
+    }
+
+    def __init__(self, data_home, name="cmu", encoding=None):
+        loader = load_cmu35 if name == "cmu" else load_mit_walk
+        self.data = data = loader(data_home)
+        self.legs = self.LEGS[name]
+        self.ids = data.sequence_ids
+        self.styles = np.asarray(data.motion, dtype=object)
+        self.style_names = tuple(dict.fromkeys(self.styles.tolist()))
+        self.preprocessor = make_motion_preprocessor(data.skeleton, **(encoding or {}))
+        with sklearn.config_context(enable_metadata_routing=True):
+            self.Z = self.preprocessor.fit_transform(data.data, sequence_ids=self.ids)
+        verdict = self.judge(self.Z, self.ids)
+        self.real = {
+            style: dict(
+                amplitude=float(np.mean(verdict.amplitude[self.styles == style])),
+                frequency=float(np.nanmean(verdict.frequency[self.styles == style])),
+            )
+            for style in self.style_names
+        }
+
+    def judge(self, Z, sequence_ids, expected_styles=None, last_frames=None):
+        """``metrics.judge_generated_motion`` of ``Z`` against the real motion."""
+        return judge_generated_motion(
+            Z,
+            self.Z,
+            reference_styles=self.styles,
+            preprocessor=self.preprocessor,
+            expected_styles=expected_styles,
+            sequence_ids=sequence_ids,
+            reference_sequence_ids=self.ids,
+            legs=self.legs,
+            frame_rate=self.data.frame_rate,
+            last_frames=last_frames,
+        )
+
+    def seed_windows(self, model, n_per_style, seed):
+        """``(history, styles)``: ``n_per_style`` real windows of every style."""
+        pipeline = MotionPipeline([*self.preprocessor.steps, ("model", model)])
+        with sklearn.config_context(enable_metadata_routing=True):
+            windows = pipeline.style_windows(
+                self.data.data,
+                self.styles[self.ids],
+                sequence_ids=self.ids,
+                n_windows=n_per_style,
+                random_state=seed,
+            )
+        styles = np.repeat(np.array(self.style_names, dtype=object), n_per_style)
+        return np.concatenate([windows[s] for s in self.style_names]), styles
+
+
 def synthetic_motion(n_frames, n_features, n_sequences, dtype=np.float64, seed=0):
     """Standardised smooth random motion in long format (a stand-in for mocap)."""
     rng = np.random.default_rng(seed)
     lengths = np.full(n_sequences, n_frames // n_sequences)
     lengths[: n_frames - lengths.sum()] += 1
     X = np.empty((n_frames, n_features), dtype=dtype)
-    # sinusoids with random phases and frequencies plus noise, chunk by chunk
     freq = rng.uniform(0.05, 0.4, n_features).astype(dtype)
     step = 100_000
-    for lo in range(0, n_frames, step):
+    for lo in range(0, n_frames, step):  # sinusoids plus noise, chunk by chunk
         t = np.arange(lo, min(lo + step, n_frames), dtype=dtype)[:, None]
         block = np.sin(t * freq + np.arange(n_features, dtype=dtype))
         block += 0.1 * rng.standard_normal(block.shape).astype(dtype)
@@ -182,67 +251,319 @@ def synthetic_motion(n_frames, n_features, n_sequences, dtype=np.float64, seed=0
 
 
 def load_training_data(name, data_home, dtype=np.float64):
-    """The preprocessed training data of ``name`` ("cmu35" or "mit").
+    """``(X, sequence_ids, source)``: "cmu35" or "mit", preprocessed.
 
-    Returns ``(X, sequence_ids, source)``; ``source`` says whether real data
-    was used or, when it is missing, a synthetic stand-in of the same shape.
+    Where the data is missing, a synthetic stand-in of the same shape, and
+    ``source`` says so.
     """
     try:
-        import sklearn as sk
-
-        from sklearn_crbm.datasets import load_cmu35, load_mit_walk
-        from sklearn_crbm.preprocessing import make_motion_preprocessor
-
         bunch = (
             load_cmu35(data_home, subset="train")
             if name == "cmu35"
             else load_mit_walk(data_home)
         )
-        with sk.config_context(enable_metadata_routing=True):
-            pre = make_motion_preprocessor(bunch.skeleton)
-            X = pre.fit_transform(bunch.data, sequence_ids=bunch.sequence_ids)
-        source = (
-            "CMU subject 35, 31 training trials" if name == "cmu35" else "MIT walking"
-        )
-        return np.asarray(X, dtype=dtype), np.asarray(bunch.sequence_ids), source
-    except (ImportError, OSError) as exc:
+    except OSError as exc:
         shape = (2644, 62, 31) if name == "cmu35" else (3826, 49, 3)
         X, ids = synthetic_motion(*shape, dtype=dtype)
-        return (
-            X,
-            ids,
-            f"synthetic stand-in ({exc.__class__.__name__}: real data missing)",
+        return X, ids, f"synthetic stand-in ({type(exc).__name__}: no real data)"
+    with sklearn.config_context(enable_metadata_routing=True):
+        pre = make_motion_preprocessor(bunch.skeleton)
+        X = pre.fit_transform(bunch.data, sequence_ids=bunch.sequence_ids)
+    source = "CMU subject 35, 31 training trials" if name == "cmu35" else "MIT walk"
+    return np.asarray(X, dtype=dtype), np.asarray(bunch.sequence_ids), source
+
+
+# ------------------------------------------------------------- model cache
+
+# A fit runs the models' modules and utils/, never these (nor the packages'
+# __init__ files, which only re-export): they are left out of the cache key,
+# so that changing them does not refit.
+_NOT_IN_A_FIT = {
+    "datasets",
+    "preprocessing",
+    "impute",
+    "metrics",
+    "model_selection",
+    "plotting",
+    "_cli.py",
+    "__main__.py",
+}
+
+
+def model_code_digest():
+    """A digest of every module of the package under test that a fit can run.
+
+    Docstrings and comments are left out: a change of the documentation
+    alone does not refit.
+    """
+    digest = hashlib.sha1()
+    for path in sorted(PACKAGE.rglob("*.py")):
+        relative = path.relative_to(PACKAGE)
+        if relative.parts[0] not in _NOT_IN_A_FIT and path.name != "__init__.py":
+            digest.update(str(relative).encode() + _code(path).encode())
+    return digest.hexdigest()
+
+
+def _code(path):
+    """The module's syntax tree without its docstrings, as text."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    for node in ast.walk(tree):
+        body = getattr(node, "body", None)
+        if (
+            isinstance(body, list)
+            and body
+            and isinstance(body[0], ast.Expr)
+            and isinstance(body[0].value, ast.Constant)
+            and isinstance(body[0].value.value, str)
+        ):
+            node.body = body[1:] or [ast.Pass()]
+    return ast.dump(tree)
+
+
+def cached_fit(model, X, sequence_ids):
+    """``(fitted model, fit seconds)``, read from the cache when it is there.
+
+    The key is the model's class and parameters, the data and the package's
+    code (:func:`model_code_digest`), so changed code fits again.
+    """
+    key = hashlib.sha1(model_code_digest().encode())
+    key.update(type(model).__name__.encode())
+    key.update(repr(sorted(model.get_params().items())).encode())
+    key.update(np.ascontiguousarray(X).tobytes())
+    key.update(np.ascontiguousarray(sequence_ids).tobytes())
+    path = CACHE / f"{type(model).__name__}_{key.hexdigest()[:24]}.joblib"
+    if path.exists():
+        return joblib.load(path)
+    start = time.perf_counter()
+    model.fit(X, sequence_ids=sequence_ids)
+    result = (model, time.perf_counter() - start)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    joblib.dump(result, path)
+    return result
+
+
+# ----------------------------------------------------------------- fill-in
+
+
+def fitted_baselines(X, sequence_ids):
+    """The simple imputers a user tries first, fitted on ``X``, by name."""
+    imputers = {
+        "NearestNeighborImputer": NearestNeighborImputer(),
+        "KNNImputer(1)": KNNImputer(n_neighbors=1),
+        "KNNImputer(5)": KNNImputer(n_neighbors=5),
+        "KNNImputer(10)": KNNImputer(n_neighbors=10),
+        "AR(3), full covariance": AutoregressiveImputer(order=3),
+        "AR(3), diagonal": AutoregressiveImputer(order=3, covariance_type="diag"),
+    }
+    for imputer in imputers.values():
+        if isinstance(imputer, AutoregressiveImputer):
+            imputer.fit(X, sequence_ids=sequence_ids)
+        else:
+            imputer.fit(X)
+    return imputers
+
+
+def crbm_imputer(X, sequence_ids, seed, model_params=None, imputer_params=None):
+    """``(CRBMImputer, fit seconds)``: the defaults, around a cached model fit.
+
+    ``model_params`` and ``imputer_params`` change the defaults of
+    ``ConditionalRBM`` and ``CRBMImputer``.
+    """
+    model = ConditionalRBM(random_state=seed, **(model_params or {}))
+    fitted, seconds = cached_fit(model, X, sequence_ids)
+    imputer = CRBMImputer(
+        FrozenEstimator(fitted), random_state=seed, **(imputer_params or {})
+    )
+    return imputer.fit(X, sequence_ids=sequence_ids), seconds
+
+
+def fill_errors(imputers, cases):
+    """The paper's error of every imputer (by name) on every case (by key)."""
+    scores = compare_imputers(imputers, cases)
+    return {
+        name: {key: score["error"] for key, score in per_case.items()}
+        for name, per_case in scores.items()
+    }
+
+
+def log_ratio_row(name, log_ratios):
+    """Mean log error ratio over seeds, its interval, and the cells won.
+
+    ``log_ratios``: ``log(CRBM error / reference error)``, one row per
+    training seed (and any number of cells per row).
+    """
+    mean, low, high = bootstrap_mean(log_ratios)
+    return dict(
+        cells=name,
+        mean=mean,
+        low=low,
+        high=high,
+        verdict="better" if high < 0 else "worse" if low > 0 else "not significant",
+        won=int(np.sum(np.asarray(log_ratios) < 0)),
+        of=int(np.size(log_ratios)),
+    )
+
+
+def log_ratio_columns(reference="best baseline"):
+    """The columns of :func:`log_ratio_row`'s table."""
+    return [
+        ("cells", "cells", "s"),
+        ("mean", f"mean log(CRBM / {reference})", "+.3f"),
+        ("low", "95% low", "+.3f"),
+        ("high", "95% high", "+.3f"),
+        ("verdict", f"than the {reference}", "s"),
+        ("won", "cells won", "d"),
+        ("of", "of", "d"),
+    ]
+
+
+# ------------------------------------------------------------- statistics
+
+
+def bootstrap_mean(values, n_resamples=10_000, level=0.95, seed=0):
+    """Mean of ``values`` and its percentile bootstrap interval over seeds.
+
+    ``values`` has one row per training seed (and any number of cells per
+    row); the rows are resampled with replacement.  Returns ``(mean, low,
+    high)``.
+    """
+    values = np.asarray(values, dtype=float).reshape(len(values), -1)
+    rows = np.random.default_rng(seed).integers(
+        len(values), size=(n_resamples, len(values))
+    )
+    means = values[rows].mean(axis=(1, 2))
+    low, high = np.quantile(means, [(1 - level) / 2, (1 + level) / 2])
+    return float(values.mean()), float(low), float(high)
+
+
+# ------------------------------------------------------------------ timing
+
+
+@contextmanager
+def threadpool_limits(threads):
+    """``threads`` BLAS threads, for the libraries and the package's loops."""
+    with (
+        threadpoolctl.threadpool_limits(threads),
+        sklearn_crbm.config_context(blas_threads=threads),
+    ):
+        yield
+
+
+def time_both(func):
+    """Wall-clock and process CPU seconds of one call of ``func``.
+
+    With one BLAS thread the CPU time leaves out the time spent waiting for
+    a core: the steadier measure on a shared machine.
+    """
+    wall, cpu = time.perf_counter(), time.process_time()
+    func()
+    return time.perf_counter() - wall, time.process_time() - cpu
+
+
+def summary(times):
+    return {"best": min(times), "median": statistics.median(times), "all": times}
+
+
+def gemm_peak(dtype, n=2000, repeats=3):
+    """``(wall, cpu)`` GFLOP/s of an ``n x n`` matrix product, best of ``repeats``."""
+    rng = np.random.default_rng(0)
+    a, b = (rng.standard_normal((n, n)).astype(dtype) for _ in range(2))
+    out = np.empty((n, n), dtype)
+    np.matmul(a, b, out=out)  # warm up
+    times = [time_both(lambda: np.matmul(a, b, out=out)) for _ in range(repeats)]
+    return tuple(2.0 * n**3 / min(t) / 1e9 for t in zip(*times, strict=True))
+
+
+def cd_epoch_flops(n_frames, n_features, n_components, order, cd_steps=1):
+    """FLOPs of the matrix products of one CD-k epoch (2 m n k per product).
+
+    Per frame: dynamic biases, positive hidden input, per step the
+    reconstruction and the negative hidden input, the W statistics and the
+    directed statistics.  Elementwise work is not counted.
+    """
+    d, h, k = n_features, n_components, order * n_features
+    return (
+        2
+        * n_frames
+        * (k * (d + h) + d * h + cd_steps * 2 * d * h + 2 * d * h + (d + h) * k)
+    )
+
+
+def frames_with_history(sequence_ids, order):
+    """Indices of the frames with ``order`` past frames in their own sequence.
+
+    The frames a model of that order trains on and scores (sequences are
+    contiguous runs of equal ids).
+    """
+    ids = np.asarray(sequence_ids)
+    starts = np.r_[0, np.flatnonzero(ids[1:] != ids[:-1]) + 1]
+    lengths = np.diff(np.r_[starts, len(ids)])
+    position = np.arange(len(ids)) - np.repeat(starts, lengths)
+    return np.flatnonzero(position >= order)
+
+
+def epoch_batch_sizes(n_frames, batch_size):
+    """Minibatch sizes of one epoch: ``ceil(n / batch_size)`` batches, near-equal."""
+    n_batches = -(-n_frames // batch_size)
+    size, extra = divmod(n_frames, n_batches)
+    return [size + 1] * extra + [size] * (n_batches - extra)
+
+
+class EpochProducts:
+    """The six matrix products of every minibatch of one CD-1 epoch, alone.
+
+    The shapes and memory layouts of training (weights in Fortran order),
+    into preallocated outputs: the time no implementation that leaves these
+    products to BLAS can beat.
+    """
+
+    def __init__(self, n_features, n_components, order, batch_size, dtype):
+        rng = np.random.default_rng(0)
+        d, h, k, n = n_features, n_components, order * n_features, batch_size
+
+        def random(*shape, order="C"):
+            return np.asarray(rng.standard_normal(shape).astype(dtype), order=order)
+
+        self.W, self.dynamic = random(h, d, order="F"), random(d + h, k, order="F")
+        self.v, self.h, self.hist = random(n, d), random(n, h), random(n, k)
+        self.vs, self.hs, self.delta = (
+            random(2 * n, d),
+            random(2 * n, h),
+            random(n, d + h),
         )
+        self.out_dyn, self.out_h = np.empty((n, d + h), dtype), np.empty((n, h), dtype)
+        self.out_v = np.empty((n, d), dtype)
+        self.out_w = np.empty((h, d), dtype, order="F")
+        self.out_d = np.empty((d + h, k), dtype, order="F")
+
+    def epoch(self, batch_sizes):
+        for n in batch_sizes:
+            np.matmul(self.hist[:n], self.dynamic.T, out=self.out_dyn[:n])
+            np.matmul(self.v[:n], self.W.T, out=self.out_h[:n])
+            np.matmul(self.h[:n], self.W, out=self.out_v[:n])
+            np.matmul(self.v[:n], self.W.T, out=self.out_h[:n])
+            np.matmul(self.hs[: 2 * n].T, self.vs[: 2 * n], out=self.out_w)
+            np.matmul(self.delta[:n].T, self.hist[:n], out=self.out_d)
 
 
-# ----------------------------------------------------------------- output
+# ------------------------------------------------------------------ output
 
 
 def print_table(rows, columns, title=None):
-    """Print ``rows`` (dicts) as an aligned text table with the given columns.
-
-    ``columns`` is a list of ``(key, header, format)``.
-    """
+    """Print ``rows`` (dicts) as a Markdown table; ``columns``: (key, header, format)."""
     cells = [[header for _, header, _ in columns]]
     for row in rows:
         cells.append(
-            [
-                ("" if row.get(key) is None else format(row[key], fmt))
-                for key, _, fmt in columns
-            ]
+            ["" if row.get(k) is None else format(row[k], f) for k, _, f in columns]
         )
     widths = [max(len(r[i]) for r in cells) for i in range(len(columns))]
-    lines = []
-    if title:
-        lines.append(title)
+    lines = [title] if title else []
     for i, r in enumerate(cells):
-        lines.append(
-            "| "
-            + " | ".join(
-                c.rjust(w) if i else c.ljust(w) for c, w in zip(r, widths, strict=True)
-            )
-            + " |"
+        padded = (
+            c.ljust(w) if i == 0 or f == "s" else c.rjust(w)
+            for c, w, (_, _, f) in zip(r, widths, columns, strict=True)
         )
+        lines.append("| " + " | ".join(padded) + " |")
         if i == 0:
             lines.append("|" + "|".join("-" * (w + 2) for w in widths) + "|")
     text = "\n".join(lines)
@@ -251,9 +572,15 @@ def print_table(rows, columns, title=None):
 
 
 def write_json(name, payload, output=None):
+    """Write ``payload`` with the machine and the package under test."""
     path = Path(output) if output else RESULTS / f"{name}.json"
     path.parent.mkdir(parents=True, exist_ok=True)
-    payload = {"benchmark": name, "machine": machine(), **payload}
+    payload = {
+        "benchmark": name,
+        "package": package_description(),
+        "machine": machine(),
+        **payload,
+    }
     path.write_text(json.dumps(payload, indent=2, default=_jsonable))
     print(f"wrote {path}")
     return path
@@ -265,20 +592,3 @@ def _jsonable(value):
     if isinstance(value, np.ndarray):
         return value.tolist()
     return str(value)
-
-
-__all__ = [
-    "PAPER",
-    "add_common_arguments",
-    "cd_epoch_flops",
-    "gemm_peak",
-    "load_training_data",
-    "machine",
-    "print_table",
-    "summary",
-    "synthetic_motion",
-    "threadpool_limits",
-    "time_both",
-    "time_call",
-    "write_json",
-]

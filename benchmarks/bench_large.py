@@ -13,7 +13,7 @@ Rows, the best of ``--repeats`` timed calls (a run takes minutes, not hours):
   BLAS thread and with all of them (``sklearn_crbm.config_context(
   blas_threads=...)``): frames per second;
 - ``products``: the six matrix products of the same minibatches alone
-  (``bench_train.products_only_epoch``), the ceiling of any implementation
+  (as in ``bench_train.py``), the ceiling of any implementation
   that leaves them to BLAS; ``train / products`` is the overhead the issue
   bounds at 1.3;
 - ``sample``: ``sample`` of ``--gen-frames`` frames for 1000 sequences
@@ -48,20 +48,19 @@ import tracemalloc  # noqa: E402
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
 from _common import (  # noqa: E402
+    EpochProducts,
+    announce,
     cd_epoch_flops,
+    epoch_batch_sizes,
+    frames_with_history,
     gemm_peak,
     print_table,
     synthetic_motion,
     threadpool_limits,
     write_json,
 )
-from bench_train import products_buffers, products_only_epoch  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
-from sklearn_crbm.utils._sequences import (  # noqa: E402
-    balanced_batches,
-    check_sequence_ids,
-)
 
 
 def load_corpus(args, dtype):
@@ -87,9 +86,8 @@ def load_corpus(args, dtype):
 
 def first_sequences(ids, n_frames):
     """Rows of the first whole sequences holding at least ``n_frames`` frames."""
-    sequences = check_sequence_ids(ids, len(ids))
-    last = np.searchsorted(np.cumsum(sequences.lengths), n_frames)
-    return slice(0, int(sequences.stops[min(last, sequences.n_sequences - 1)]))
+    stops = np.r_[np.flatnonzero(ids[1:] != ids[:-1]) + 1, len(ids)]
+    return slice(0, int(stops[min(np.searchsorted(stops, n_frames), len(stops) - 1)]))
 
 
 def model(args, batch_size, random_state=0):
@@ -133,7 +131,7 @@ def cpu_rows(args, X, ids, dtype, threads):
     # memory: a short run of the same call (its buffers do not grow with X)
     short = first_sequences(ids, 5000)
     with threadpool_limits(threads):  # how much the threads give on a large product
-        gemm = gemm_peak(dtype, 2000)
+        gemm = gemm_peak(dtype, 2000)[0]
     rows = [
         dict(
             dtype=np.dtype(dtype).name,
@@ -145,18 +143,17 @@ def cpu_rows(args, X, ids, dtype, threads):
     ]
     trained = None
     for batch_size in args.batch_sizes:
-        valid = check_sequence_ids(ids_train, len(ids_train)).valid_frames(args.order)
-        batches = balanced_batches(valid, batch_size, np.random.default_rng(0))
-        sizes = [len(b) for b in batches]
-        buffers = products_buffers(
+        valid = frames_with_history(ids_train, args.order)
+        sizes = epoch_batch_sizes(len(valid), batch_size)
+        products = EpochProducts(
             X.shape[1], args.components, args.order, batch_size, dtype
         )
         with threadpool_limits(threads):
             # warmed up: started on a few frames, then timed on many
             estimator = model(args, batch_size)
             estimator.partial_fit(X[short], sequence_ids=ids[short])
-            products_only_epoch(buffers, sizes[:5])
-            seconds = products = math.inf
+            products.epoch(sizes[:5])
+            seconds = products_seconds = math.inf
             for _ in range(args.repeats):  # interleaved: load changes hit both
                 seconds = min(
                     seconds,
@@ -166,9 +163,8 @@ def cpu_rows(args, X, ids, dtype, threads):
                         )
                     ),
                 )
-                products = min(
-                    products,
-                    timed(lambda b=buffers, s=sizes: products_only_epoch(b, s)),
+                products_seconds = min(
+                    products_seconds, timed(lambda p=products, s=sizes: p.epoch(s))
                 )
             peak = peak_mb(
                 lambda b=batch_size: model(args, b).partial_fit(
@@ -187,7 +183,7 @@ def cpu_rows(args, X, ids, dtype, threads):
                 frames_per_s=len(valid) / seconds,
                 gflops=flops / seconds / 1e9,
                 peak_mb=peak,
-                over_products=seconds / products,
+                over_products=seconds / products_seconds,
             )
         )
         rows.append(
@@ -196,9 +192,9 @@ def cpu_rows(args, X, ids, dtype, threads):
                 device="cpu",
                 task="products",
                 frames=len(valid),
-                seconds=products,
-                frames_per_s=len(valid) / products,
-                gflops=flops / products / 1e9,
+                seconds=products_seconds,
+                frames_per_s=len(valid) / products_seconds,
+                gflops=flops / products_seconds / 1e9,
             )
         )
         trained = estimator
@@ -243,7 +239,7 @@ def gpu_rows(args, torch, X, ids, dtype):
     sync = torch.cuda.synchronize
     part = first_sequences(ids, args.gpu_train_frames)
     ids_train = ids[part]
-    valid = check_sequence_ids(ids_train, len(ids_train)).valid_frames(args.order)
+    valid = frames_with_history(ids_train, args.order)
     with sklearn.config_context(array_api_dispatch=True):
         X_gpu = torch.asarray(X[part], device="cuda")
         model(args, 100).partial_fit(X_gpu[:5000], sequence_ids=ids_train[:5000])
@@ -352,7 +348,7 @@ def main(argv=None):
     )
     parser.add_argument("--output", default=None)
     args = parser.parse_args(argv)
-
+    announce()
     torch, no_gpu = cuda_device()
     rows, corpora = [], {}
     for dtype_name in args.dtypes:
@@ -363,9 +359,9 @@ def main(argv=None):
         if torch is not None:
             rows.extend(gpu_rows(args, torch, X, ids, dtype))
     columns = [
-        ("task", "task", ""),
-        ("device", "device", ""),
-        ("dtype", "dtype", ""),
+        ("task", "task", "s"),
+        ("device", "device", "s"),
+        ("dtype", "dtype", "s"),
         ("threads", "threads", "d"),
         ("batch", "batch", "d"),
         ("frames", "frames", "d"),
@@ -387,8 +383,8 @@ def main(argv=None):
         print_table(
             gains,
             [
-                ("task", "task", ""),
-                ("dtype", "dtype", ""),
+                ("task", "task", "s"),
+                ("dtype", "dtype", "s"),
                 ("batch", "batch", "d"),
                 ("speedup", "GPU / best CPU", ".1f"),
             ],

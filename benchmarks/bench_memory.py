@@ -23,13 +23,12 @@ Run from the repository root::
 Prints a table and writes ``benchmarks/results/bench_memory.json``.
 """
 
-import argparse
 import json
 import subprocess
 import sys
 from pathlib import Path
 
-from _common import print_table, write_json
+from _common import announce, parser, print_table, write_json
 
 BUDGET_MB = 150.0
 
@@ -72,12 +71,12 @@ print(json.dumps({{
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--frames", type=int, default=1_000_000)
-    parser.add_argument("--orders", type=int, nargs="+", default=[1, 3, 6, 12])
-    parser.add_argument("--dtype", default="float32")
-    parser.add_argument("--output", default=None)
-    args = parser.parse_args(argv)
+    p = parser(__doc__, seeds=None)
+    p.add_argument("--frames", type=int, default=1_000_000)
+    p.add_argument("--orders", type=int, nargs="+", default=[1, 3, 6, 12])
+    p.add_argument("--dtype", default="float32")
+    args = p.parse_args(argv)
+    announce()
 
     bench_dir = str(Path(__file__).resolve().parent)
     rows = []
@@ -90,9 +89,8 @@ def main(argv=None):
         )
         row = json.loads(result.stdout.strip().splitlines()[-1])
         row.update(order=order, frames=args.frames, dtype=args.dtype)
-        row["within_budget"] = (
-            max(row["traced_mb"], row["peak_rss_added_mb"]) <= BUDGET_MB
-        )
+        added = max(row["traced_mb"], row["peak_rss_added_mb"])
+        row["within_budget"] = "yes" if added <= BUDGET_MB else "NO"
         rows.append(row)
         print(f"  order {order}: {row['traced_mb']:.1f} MB traced", flush=True)
     columns = [
@@ -104,8 +102,6 @@ def main(argv=None):
         ("peak_rss_added_mb", "fit adds, peak RSS MB", ".1f"),
         ("within_budget", f"<= {BUDGET_MB:.0f} MB", "s"),
     ]
-    for row in rows:
-        row["within_budget"] = "yes" if row["within_budget"] else "NO"
     table = print_table(
         rows, columns, title="Memory of fit, 62 dims, 200 hidden, 1 epoch"
     )

@@ -1,14 +1,13 @@
-"""The demo's training with the default environment against one BLAS thread.
+"""Training with the default BLAS environment against one BLAS thread.
 
 numpy and scipy each load their own OpenBLAS, which by default starts one
 thread per core.  The package picks its own thread count for its loops
 (``sklearn_crbm.set_config(blas_threads="auto")``, one thread at batch 100);
 this script checks that a user who changes nothing gets one-thread speed.
 
-It trains the demo's model (``python -m sklearn_crbm demo``: CMU subject 35
-preprocessed, 200 hidden units, order 3, ``history_noise=0.8``, seed 0) for
-``--epochs`` epochs, each run in a fresh Python process, in three
-environments:
+It trains ``ConditionalRBM(random_state=0)`` on CMU subject 35 (the
+package's preprocessing) for ``--epochs`` epochs, each run in a fresh Python
+process, in three environments:
 
 - ``default``: no ``*_NUM_THREADS`` variable set, the package's defaults;
 - ``one thread``: ``OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1``, the speed to
@@ -23,11 +22,9 @@ Reports milliseconds per epoch (median of the repeats; a warm-up epoch is
 not timed) and the ratio of default to one thread; done when it is at most
 1.2 both quiet and loaded.
 
-Run from the repository root::
+Run from the repository root (about two minutes)::
 
-    python benchmarks/bench_threads.py            # about two minutes
-
-Prints a table and writes ``benchmarks/results/bench_threads.json``.
+    python benchmarks/bench_threads.py
 """
 
 import argparse
@@ -37,9 +34,9 @@ import statistics
 import subprocess
 import sys
 import time
-from pathlib import Path
 
-from _common import DEFAULT_DATA_HOME, print_table, write_json
+from _common import announce, load_training_data, print_table, write_json
+from _common import parser as make_parser
 
 THREAD_VARIABLES = (
     "OPENBLAS_NUM_THREADS",
@@ -64,35 +61,16 @@ def environments():
 
 
 def train_in_child(data_home, epochs, blas_threads):
-    """Child process: ms per epoch of the demo's training."""
-    import sklearn
-
+    """Child process: ms per epoch of the default model on CMU 35."""
     import sklearn_crbm
     from sklearn_crbm import ConditionalRBM
-    from sklearn_crbm._cli import _parser
-    from sklearn_crbm.datasets import load_cmu35
-    from sklearn_crbm.preprocessing import make_motion_preprocessor
 
     if blas_threads is not None:
         sklearn_crbm.set_config(blas_threads=blas_threads)
-    demo = _parser().parse_args(["demo"])
-    train = load_cmu35(data_home, subset="train")
-    with sklearn.config_context(enable_metadata_routing=True):
-        pre = make_motion_preprocessor(train.skeleton)
-        Z = pre.fit_transform(train.data, sequence_ids=train.sequence_ids)
-
-    def model(n_iter):
-        return ConditionalRBM(
-            demo.n_components,
-            order=demo.order,
-            n_iter=n_iter,
-            history_noise=demo.history_noise,
-            random_state=demo.seed,
-        )
-
-    model(1).fit(Z, sequence_ids=train.sequence_ids)  # warm up
+    Z, ids, _ = load_training_data("cmu35", data_home)
+    ConditionalRBM(n_iter=1, random_state=0).fit(Z, sequence_ids=ids)  # warm up
     start = time.perf_counter()
-    model(epochs).fit(Z, sequence_ids=train.sequence_ids)
+    ConditionalRBM(n_iter=epochs, random_state=0).fit(Z, sequence_ids=ids)
     seconds = time.perf_counter() - start
     print(json.dumps({"ms_per_epoch": 1000 * seconds / epochs}))
 
@@ -129,19 +107,12 @@ def measure(load, args):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument(
-        "--data-home",
-        type=Path,
-        default=Path(os.environ.get("SKLEARN_CRBM_DATA", DEFAULT_DATA_HOME)),
-        help="folder holding cmu_subject35/ (default: ../shared/data)",
-    )
+    parser = make_parser(__doc__, seeds=None)
     parser.add_argument("--epochs", type=int, default=100, help="timed epochs")
     parser.add_argument(
         "--old-epochs", type=int, default=10, help="timed epochs of 'all threads'"
     )
     parser.add_argument("--repeats", type=int, default=3, help="runs per row")
-    parser.add_argument("--output", default=None, help="JSON file to write")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     parser.add_argument("--child-blas-threads", type=int, help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -149,6 +120,7 @@ def main():
         train_in_child(args.data_home, args.epochs, args.child_blas_threads)
         return
 
+    announce()
     rows, raw = [], {}
     for load in ("quiet", "loaded"):
         medians, raw[load] = measure(load, args)

@@ -1,204 +1,140 @@
-"""Fill-in settings compared without the test trials: cross-validation on the training trials.
+"""Fill-in settings compared by cross-validation on the training trials alone.
 
-The held-out cells of ``fillin_baselines.py`` are the final check of issue
-15; a setting chosen by them is chosen on the test data.  This benchmark
-compares settings on the training trials alone.
+A setting chosen on the held-out cells of ``fillin_baselines.py`` is chosen
+on the test data.  This compares a setting on the 31 training trials of the
+paper's split (its test trials 35_29 and 35_18 are never read), preprocessed
+as there:
 
-Protocol:
-
-- the 31 training trials of the paper's split (its walk 35_29 and jog 35_18
-  are never read), preprocessed as in ``_splits.py``;
 - 3 folds of whole trials, walks and jogs in each (every third walk and
   every third jog, in trial order);
-- per fold, every baseline of ``fillin_baselines.py`` and one CRBM per
-  training seed (``ConditionalRBM(200, order=3, n_iter=1000)`` with its
-  defaults, changed by a variant's model parameters) are fitted on the
-  other two folds; the CRBM fills with ``CRBMImputer``'s defaults, changed
-  by the variant's imputer parameters, ``transform`` called once;
+- per fold, every simple baseline of ``fillin_baselines.py`` and one CRBM
+  per training seed (the defaults of ``ConditionalRBM`` and ``CRBMImputer``,
+  changed by ``--model`` and ``--imputer``) are fitted on the other two
+  folds;
 - each trial of the fold is filled twice, with its left leg and with its
-  upper body erased from half-way to the end (62 trial-cells per seed);
-- per variant and seed: the total error (the paper's), the mean over the
-  trial-cells of log(CRBM error / best baseline's error), and the number of
-  trial-cells in which the CRBM beats every baseline.
+  upper body erased from half-way to the end: 62 trial-cells per seed.
 
-A variant is ``--variant MODEL_JSON IMPUTER_JSON``; the default compares
-the defaults with nothing else.  Models are cached with ``fillin_baselines.py``'s
-(``--cache-dir``).  Prints a table and writes
-``benchmarks/results/fillin_cv.json``::
+Per seed: the total error and the mean over the trial-cells of
+``log(CRBM error / best baseline error)``; per kind of trial-cell
+(walk/jog x leg/upper body) and over all of them: that mean over seeds with
+its 95% bootstrap interval over seeds, and the trial-cells won.
+
+Run from the repository root (12 fits of the default model the first time;
+fitted models are cached)::
 
     python benchmarks/fillin_cv.py
-    python benchmarks/fillin_cv.py --variant '{}' '{}' \\
-        --variant '{"batch_size": 200}' '{}' --variant '{}' '{"observation_gain": 2}'
+    python benchmarks/fillin_cv.py --model '{"batch_size": 200}'
 """
 
-import os
+import json
 
-for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_name, "1")
-
-import argparse  # noqa: E402
-import json  # noqa: E402
-import tempfile  # noqa: E402
-from pathlib import Path  # noqa: E402
-
-import numpy as np  # noqa: E402
-from _common import DEFAULT_DATA_HOME, print_table, write_json  # noqa: E402
-from _splits import Split  # noqa: E402
-from fillin_baselines import (  # noqa: E402
-    baselines,
-    crbm_model,
-    errors,
-    fit_baseline,
-    frozen_imputer,
+import numpy as np
+from _common import (
+    Split,
+    announce,
+    crbm_imputer,
+    fill_errors,
+    fitted_baselines,
+    log_ratio_columns,
+    log_ratio_row,
+    parser,
+    print_table,
+    write_json,
 )
 
-from sklearn_crbm.datasets import load_cmu35  # noqa: E402
-from sklearn_crbm.model_selection import make_fillin_cases  # noqa: E402
+from sklearn_crbm.model_selection import make_fillin_cases
 
 N_FOLDS = 3
 
 
-def style_folds(cmu, trials):
-    """Trial indices per fold: every ``N_FOLDS``-th walk and jog, in order."""
+def style_folds(styles, trials):
+    """Trials per fold: every ``N_FOLDS``-th walk and jog, in trial order."""
     folds = [[] for _ in range(N_FOLDS)]
-    for style in np.unique(cmu.motion[trials]):
-        for k, trial in enumerate(t for t in trials if cmu.motion[t] == style):
+    for style in np.unique(styles[trials]):
+        for k, trial in enumerate(t for t in trials if styles[t] == style):
             folds[k % N_FOLDS].append(int(trial))
     return folds
 
 
-def by_cell_type(scores):
-    """Per variant and (style, part): mean log ratio and wins over every seed."""
-    groups = {}
-    for (name, _), cells in scores.items():
-        for c in cells:
-            groups.setdefault((name, f"{c['style']} / {c['part']}"), []).append(c)
-    rows = []
-    for (name, kind), cells in groups.items():
-        ratio = np.array([c["error"] / c["best_baseline"] for c in cells])
-        rows.append(
-            dict(
-                variant=name,
-                cells=kind,
-                log_ratio=float(np.mean(np.log(ratio))),
-                won=int(np.sum(ratio < 1)),
-                n_cells=len(cells),
+def fold_cells(split, fold, seeds, model_params, imputer_params):
+    """Every trial-cell of one fold: its kind, the CRBM's and best baseline's error."""
+    cmu = split.cmu
+    names = {cmu.sequence_names[t]: cmu.sequence_names[t] for t in fold}
+    cases = make_fillin_cases(cmu, split.preprocessor, trials=names)
+    train = ~np.isin(split.train_ids, fold)
+    X, ids = split.X_train[train].astype(np.float32), split.train_ids[train]
+    base = fill_errors(fitted_baselines(X, ids), cases).values()
+    cells = []
+    for seed in seeds:
+        imputer, _ = crbm_imputer(X, ids, seed, model_params, imputer_params)
+        for (trial, part), error in fill_errors({0: imputer}, cases)[0].items():
+            style = cmu.motion[list(cmu.sequence_names).index(trial)]
+            cells.append(
+                dict(
+                    seed=seed,
+                    trial=trial,
+                    kind=f"{style}/{'leg' if part == 'left leg' else 'upper'}",
+                    error=error,
+                    best_baseline=min(row[trial, part] for row in base),
+                )
             )
+    return cells
+
+
+def summary_rows(cells, seeds):
+    """Per seed, per kind of trial-cell and pooled: the log ratio's mean and more."""
+    log_ratio = {s: {} for s in seeds}
+    for c in cells:
+        ratio = np.log(c["error"] / c["best_baseline"])
+        log_ratio[c["seed"]].setdefault(c["kind"], []).append(ratio)
+    per_seed = [
+        dict(
+            seed=s,
+            total=sum(c["error"] for c in cells if c["seed"] == s),
+            mean=float(np.mean(np.concatenate(list(log_ratio[s].values())))),
         )
-    order = list(dict.fromkeys(name for name, _ in scores))
-    return sorted(rows, key=lambda row: (order.index(row["variant"]), row["cells"]))
-
-
-def variant_name(model_params, imputer_params):
-    parts = [f"{k}={v}" for k, v in {**model_params, **imputer_params}.items()]
-    return ", ".join(parts) or "defaults"
+        for s in seeds
+    ]
+    kinds = sorted(log_ratio[seeds[0]])
+    rows = [log_ratio_row(kind, [log_ratio[s][kind] for s in seeds]) for kind in kinds]
+    pooled = [np.concatenate([log_ratio[s][k] for k in kinds]) for s in seeds]
+    return per_seed, [*rows, log_ratio_row("all trial-cells", pooled)]
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--data-home", default=str(DEFAULT_DATA_HOME))
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1])
-    parser.add_argument(
-        "--variant",
-        nargs=2,
-        action="append",
-        metavar=("MODEL_JSON", "IMPUTER_JSON"),
-        help="ConditionalRBM and CRBMImputer parameters (JSON objects); repeat",
-    )
-    parser.add_argument(
-        "--cache-dir", default=str(Path(tempfile.gettempdir()) / "sklearn_crbm_issue15")
-    )
-    parser.add_argument("--output", default=None)
-    args = parser.parse_args(argv)
-    variants = [
-        (json.loads(m), json.loads(i)) for m, i in (args.variant or [("{}", "{}")])
-    ]
-
+    p = parser(__doc__, seeds=(0, 1, 2, 3))
+    p.add_argument("--model", default="{}", help="ConditionalRBM parameters, JSON")
+    p.add_argument("--imputer", default="{}", help="CRBMImputer parameters, JSON")
+    args = p.parse_args(argv)
+    announce()
+    model_params, imputer_params = json.loads(args.model), json.loads(args.imputer)
     split = Split(args.data_home, "paper")
-    cmu = load_cmu35(args.data_home)
-    names_list = list(cmu.sequence_names)
-    X = split.X_train.astype(np.float32)
-    folds = style_folds(cmu, np.unique(split.train_ids))
-    # per (variant, seed): the log ratios, wins and errors over every trial-cell
-    scores = {}
+    styles = np.asarray(split.cmu.motion)
+    folds = style_folds(styles, np.unique(split.train_ids))
+    cells = []
     for k, fold in enumerate(folds):
-        names = {cmu.sequence_names[t]: cmu.sequence_names[t] for t in fold}
-        cases = make_fillin_cases(cmu, split.preprocessor, trials=names)
-        train = ~np.isin(split.train_ids, fold)
-        X_fit, ids_fit = X[train], split.train_ids[train]
-        base = [
-            errors(fit_baseline(b, X_fit, ids_fit), cases) for b in baselines().values()
-        ]
-        best = {key: min(row[key] for row in base) for key in cases}
-        for model_params, imputer_params in variants:
-            name = variant_name(model_params, imputer_params)
-            for seed in args.seeds:
-                model = crbm_model("default", seed, n_iter=1000)
-                imputer, _ = frozen_imputer(
-                    args.cache_dir,
-                    model.set_params(**model_params),
-                    X_fit,
-                    ids_fit,
-                    seed,
-                )
-                imputer.set_params(**imputer_params)
-                for key, error in errors(imputer, cases).items():
-                    scores.setdefault((name, seed), []).append(
-                        dict(
-                            fold=k,
-                            trial=key[0],
-                            style=str(cmu.motion[names_list.index(key[0])]),
-                            part=key[1],
-                            error=error,
-                            best_baseline=best[key],
-                        )
-                    )
-            print(f"  fold {k}: {name} done", flush=True)
-
-    rows = []
-    for (name, seed), cells in scores.items():
-        crbm = np.array([c["error"] for c in cells])
-        best = np.array([c["best_baseline"] for c in cells])
-        rows.append(
-            dict(
-                variant=name,
-                seed=seed,
-                total=float(crbm.sum()),
-                log_ratio=float(np.mean(np.log(crbm / best))),
-                won=int(np.sum(crbm < best)),
-                n_cells=len(cells),
-            )
-        )
+        cells += fold_cells(split, fold, args.seeds, model_params, imputer_params)
+        print(f"  fold {k} done", flush=True)
+    per_seed, rows = summary_rows(cells, args.seeds)
     print_table(
-        rows,
+        per_seed,
         [
-            ("variant", "variant", "s"),
             ("seed", "seed", "d"),
             ("total", "total error", ".1f"),
-            ("log_ratio", "mean log(CRBM / best baseline)", "+.3f"),
-            ("won", "trial-cells won", "d"),
-            ("n_cells", "of", "d"),
+            ("mean", "mean log(CRBM / best baseline)", "+.3f"),
         ],
-        title="\nFill-in, 3-fold cross-validation on the paper split's training trials",
+        title="\n3-fold cross-validation on the paper split's training trials",
     )
-    print_table(
-        by_cell_type(scores),
-        [
-            ("variant", "variant", "s"),
-            ("cells", "trial-cells", "s"),
-            ("log_ratio", "mean log(CRBM / best baseline)", "+.3f"),
-            ("won", "won", "d"),
-            ("n_cells", "of", "d"),
-        ],
-        title="\nBy kind of trial-cell, all seeds together",
-    )
+    table = print_table(rows, log_ratio_columns(), title="\nBy kind of trial-cell")
     write_json(
         "fillin_cv",
         dict(
             args=vars(args),
-            folds=[[cmu.sequence_names[t] for t in fold] for fold in folds],
-            rows=rows,
-            cells={f"{name} | seed {seed}": c for (name, seed), c in scores.items()},
+            folds=[[split.cmu.sequence_names[t] for t in f] for f in folds],
+            per_seed=per_seed,
+            log_ratios=rows,
+            cells=cells,
+            table=table,
         ),
         args.output,
     )

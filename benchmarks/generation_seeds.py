@@ -1,247 +1,121 @@
-"""Generated walks and jogs that keep their style and their legs, every seed (issue 15).
+"""Generation: do generated walks and jogs keep their style, for every seed?
 
-Protocol:
+Protocol, per training seed and joint encoding (``--encodings``: the
+paper's, ``reference="rest", roll="taylor"``, and the package's default):
 
-- one ConditionalRBM per training seed on all 33 CMU subject 35 trials
-  (200 hidden units, order 3, ``--n-iter`` 1000 epochs; ``default``: every
-  other parameter at its default, ``paper``:
-  ``ConditionalRBM.paper_schedule``; ``bare``: ``ConditionalRBM()``, every
-  parameter but ``random_state`` at its default, ``--n-iter`` ignored;
-  ``unaveraged``: ``default`` with ``average_fraction=0`` (the last
-  epoch's parameters, the defaults before averaging); ``every-channel``:
-  ``default`` with the noise of the defaults before
-  ``history_noise_fraction``, ``history_noise=0.8`` on every channel, not
-  averaged; ``centred``: that with ``centering=True``),
-  cached with the other generation benchmarks;
-- per training seed, 6 walk-seeded and 6 jog-seeded sequences of 1000
-  frames (seeds of the model's ``history_length`` real frames, ``order``
-  unless ``hidden_order`` is larger, drawn as in ``generation_styles.py``;
-  ``sample`` with its defaults);
-- judged over frames 200-299 (the last 100 of the first 300) and over
-  frames 900-999 (the last 100 of 1000); a sequence *passes* a window when
-  it keeps its seed's style (nearest style on forward speed and step
-  frequency), never leaves |z| <= 10, its leg amplitude (RMS of the
-  per-channel standard deviations of the femur and tibia channels) is
-  within 25% of the real trials of its style, and its step frequency within
-  15% of theirs.
+- one ``ConditionalRBM(random_state=seed)`` (the defaults, changed by
+  ``--model``) on all 33 trials of CMU subject 35, preprocessed;
+- 6 walk-seeded and 6 jog-seeded sequences of 1000 frames, each seeded with
+  ``history_length`` real frames of its style
+  (``MotionPipeline.style_windows``), ``sample`` at its defaults;
+- each sequence judged (``metrics.judge_generated_motion``) over frames
+  200-299 and 900-999: it *passes* a window when it keeps its seed's style
+  (the nearest real style on speed and step frequency), never leaves
+  |z| <= 10, and its leg amplitude is within 25% and its step frequency
+  within 15% of the mean of the real trials of its style.
 
-Prints one row per model and seed, and writes JSON (every sequence's
-statistics) to ``benchmarks/results/generation_seeds.json``::
+The criterion is the number of windows passing: 2 windows x 12 sequences per
+seed and encoding, 240 for seeds 0-4 and both encodings.
+
+Run from the repository root (10 fits of the default model the first time;
+fitted models are cached)::
 
     python benchmarks/generation_seeds.py
-    python benchmarks/generation_seeds.py --models paper --seeds 0 1
-    python benchmarks/generation_seeds.py --models bare
+    python benchmarks/generation_seeds.py --seeds 0 --encodings paper
 """
 
-import os
+import json
 
-for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_name, "1")
+import numpy as np
+from _common import (
+    PAPER_ENCODING,
+    MotionCorpus,
+    announce,
+    cached_fit,
+    parser,
+    print_table,
+    write_json,
+)
 
-import argparse  # noqa: E402
-import json  # noqa: E402
-import tempfile  # noqa: E402
-from pathlib import Path  # noqa: E402
+from sklearn_crbm import ConditionalRBM
 
-import numpy as np  # noqa: E402
-from _splits import EARLIER_DEFAULTS, UNAVERAGED, cached_model  # noqa: E402
-from generation_styles import Motion, draw_seeds, judge  # noqa: E402
-
-from sklearn_crbm import ConditionalRBM  # noqa: E402
-from sklearn_crbm.datasets import load_cmu35  # noqa: E402
-from sklearn_crbm.preprocessing import make_motion_preprocessor  # noqa: E402
-
-REPO = Path(__file__).resolve().parents[1]
+ENCODINGS = {"paper": PAPER_ENCODING, "default": {}}
 STYLES = ("walk", "jog")
-AMPLITUDE_TOLERANCE = 0.25
-FREQUENCY_TOLERANCE = 0.15
-WINDOWS = {"frames 200-299": 300, "frames 900-999": 1000}  # window -> its end
+N_PER_STYLE = 6
+WINDOWS = {"200-299": 300, "900-999": 1000}  # frames judged -> their end
+AMPLITUDE_TOLERANCE, FREQUENCY_TOLERANCE = 0.25, 0.15
 
 
-def model(name, seed, n_iter, n_components=200):
-    if name == "paper":
-        return ConditionalRBM.paper_schedule(n_iter=n_iter, random_state=seed)
-    if name == "bare":
-        return ConditionalRBM(random_state=seed)
-    default = ConditionalRBM(n_components, order=3, n_iter=n_iter, random_state=seed)
-    if name in ("every-channel", "centred"):
-        default.set_params(**EARLIER_DEFAULTS)  # the defaults of then
-    if name == "unaveraged":
-        default.set_params(**UNAVERAGED)
-    return default.set_params(centering=name == "centred")
-
-
-def real_statistics(motion):
-    """Mean leg amplitude and step frequency of the real trials of each style."""
-    stats = motion.train_stats
-    return {
-        style: dict(
-            amplitude=float(np.mean(stats["amplitude"][motion.styles == style])),
-            frequency=float(np.nanmean(stats["frequency"][motion.styles == style])),
-        )
-        for style in STYLES
-    }
-
-
-def verdicts(motion, generated, n_frames, end, seed_styles, real):
-    """Per-sequence statistics over the 100 frames before ``end``, and the bar."""
-    n_sequences = len(seed_styles)
-    window = generated.reshape(n_sequences, n_frames, -1)[:, :end].reshape(
-        n_sequences * end, -1
-    )
-    stats = judge(motion, window, end, seed_styles, last_frames=100)
-    reference = {
-        key: np.array([real[s][key] for s in seed_styles])
+def passes(corpus, generated, n_frames, end, seed_styles):
+    """Which sequences pass the window of 100 frames before ``end``."""
+    n = len(seed_styles)
+    window = generated.reshape(n, n_frames, -1)[:, :end].reshape(n * end, -1)
+    ids = np.repeat(np.arange(n), end)
+    verdict = corpus.judge(window, ids, seed_styles, last_frames=100)
+    amplitude, frequency = (
+        np.array([corpus.real[s][key] for s in seed_styles])
         for key in ("amplitude", "frequency")
-    }
-    stats["lively"] = (
-        np.abs(stats["amplitude"] / reference["amplitude"] - 1) <= AMPLITUDE_TOLERANCE
     )
-    stats["in_step"] = (
-        np.abs(stats["frequency"] / reference["frequency"] - 1) <= FREQUENCY_TOLERANCE
-    )
-    stats["passes"] = (
-        (stats["style"] == seed_styles)
-        & ~stats["blown"]
-        & stats["lively"]
-        & stats["in_step"]
-    )
-    return stats
+    lively = np.abs(verdict.amplitude / amplitude - 1) <= AMPLITUDE_TOLERANCE
+    in_step = np.abs(verdict.frequency / frequency - 1) <= FREQUENCY_TOLERANCE
+    return (verdict.style == seed_styles) & ~verdict.blown & lively & in_step, verdict
 
 
-def summary(stats, seed_styles):
-    row = {}
-    for style in STYLES:
-        mine = seed_styles == style
-        row[style] = dict(
-            passes=int(stats["passes"][mine].sum()),
-            keeps_style=int((stats["style"][mine] == style).sum()),
-            blown=int(stats["blown"][mine].sum()),
-            lively=int(stats["lively"][mine].sum()),
-            in_step=int(stats["in_step"][mine].sum()),
-            amplitude=[round(float(a), 3) for a in stats["amplitude"][mine]],
-            frequency=[round(float(f), 3) for f in stats["frequency"][mine]],
-            speed=[round(float(v), 3) for v in stats["speed"][mine]],
-        )
-    return row
+def generate_and_judge(corpus, seed, model_params):
+    model = ConditionalRBM(random_state=seed, **model_params)
+    model, _ = cached_fit(model, corpus.Z.astype(np.float32), corpus.ids)
+    history, seed_styles = corpus.seed_windows(model, N_PER_STYLE, seed)
+    n_frames = max(WINDOWS.values())
+    generated = model.sample(n_frames, history=history, random_state=seed)
+    row, details = {}, {}
+    for window, end in WINDOWS.items():
+        passed, verdict = passes(corpus, generated, n_frames, end, seed_styles)
+        for style in STYLES:
+            mine = seed_styles == style
+            row[f"{style} {window}"] = int(passed[mine].sum())
+            details[f"{style} {window}"] = dict(
+                passes=passed[mine].tolist(),
+                style=verdict.style[mine].tolist(),
+                amplitude=verdict.amplitude[mine].tolist(),
+                frequency=verdict.frequency[mine].tolist(),
+                blown=verdict.blown[mine].tolist(),
+            )
+    return row, details
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--data-home", default=str(REPO.parent / "shared" / "data"))
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
-    parser.add_argument(
-        "--models",
-        nargs="+",
-        default=["default", "paper"],
-        choices=["default", "paper", "bare", "unaveraged", "centred", "every-channel"],
-    )
-    parser.add_argument("--n-iter", type=int, default=1000)
-    parser.add_argument(
-        "--n-components", type=int, default=200, help="hidden units of 'default'"
-    )
-    parser.add_argument(
-        "--encoding",
-        default="paper",
-        choices=["paper", "default"],
-        help="joint encoding: the paper's (rest pose, Taylor's roll) or the "
-        "package's default (each joint's mean rotation)",
-    )
-    parser.add_argument("--n-per-style", type=int, default=6)
-    parser.add_argument(
-        "--cache-dir", default=str(Path(tempfile.gettempdir()) / "sklearn_crbm_issue15")
-    )
-    parser.add_argument(
-        "--output",
-        default=str(REPO / "benchmarks" / "results" / "generation_seeds.json"),
-    )
-    args = parser.parse_args(argv)
-
-    cmu = load_cmu35(args.data_home)
-    # the paper's encoding, in which the tables of the README were measured,
-    # or the package's default one
-    paper = dict(reference="rest", roll="taylor") if args.encoding == "paper" else {}
-    preprocessor = make_motion_preprocessor(cmu.skeleton, **paper)
-    motion = Motion(
-        cmu.data, cmu.sequence_ids, cmu.motion, preprocessor, cmu.frame_rate
-    )
-    real = real_statistics(motion)
-    print(
-        "real trials: "
-        + "; ".join(
-            f"{s} leg amplitude {real[s]['amplitude']:.2f}, step frequency "
-            f"{real[s]['frequency']:.2f} Hz"
-            for s in STYLES
-        )
-    )
-    n_frames = max(WINDOWS.values())
-    rows = []
-    for name in args.models:
+    p = parser(__doc__)
+    p.add_argument("--encodings", nargs="+", default=list(ENCODINGS), choices=ENCODINGS)
+    p.add_argument("--model", default="{}", help="ConditionalRBM parameters, JSON")
+    args = p.parse_args(argv)
+    announce()
+    model_params = json.loads(args.model)
+    rows, details = [], {}
+    for encoding in args.encodings:
+        corpus = MotionCorpus(args.data_home, "cmu", ENCODINGS[encoding])
         for seed in args.seeds:
-            crbm, seconds = cached_model(
-                args.cache_dir,
-                model(name, seed, args.n_iter, args.n_components),
-                motion.Z.astype(np.float32),
-                motion.ids,
+            row, details[f"{encoding} {seed}"] = generate_and_judge(
+                corpus, seed, model_params
             )
-            seeds, seed_styles = draw_seeds(
-                motion,
-                args.n_per_style,
-                crbm.history_length,
-                np.random.default_rng(seed),
-            )
-            generated = crbm.sample(n_frames, history=seeds, random_state=seed)
-            row = dict(model=name, seed=seed, train_seconds=seconds)
-            for window, end in WINDOWS.items():
-                stats = verdicts(motion, generated, n_frames, end, seed_styles, real)
-                row[window] = summary(stats, seed_styles)
-            rows.append(row)
-            report_row(row, args.n_per_style)
-    print(markdown_table(rows, args.n_per_style))
-    output = Path(args.output)
-    output.parent.mkdir(parents=True, exist_ok=True)
-    output.write_text(json.dumps(dict(args=vars(args), real=real, rows=rows), indent=2))
-    print(f"\nwrote {output}")
-    return rows
-
-
-def report_row(row, n):
-    cells = []
-    for window in WINDOWS:
-        for style in STYLES:
-            r = row[window][style]
-            cells.append(
-                f"{window} {style}: {r['passes']}/{n} pass (style {r['keeps_style']}, "
-                f"lively {r['lively']}, in step {r['in_step']}, blown {r['blown']}; "
-                f"amplitude {min(r['amplitude']):.2f}-{max(r['amplitude']):.2f})"
-            )
-    print(
-        f"{row['model']} seed {row['seed']}:\n    " + "\n    ".join(cells), flush=True
-    )
-
-
-def markdown_table(rows, n):
-    """One line per model and seed: passes, leg amplitude and step frequency."""
-
-    def spread(values):
-        return f"{min(values):.2f}-{max(values):.2f}"
-
-    lines = [
-        "",
-        "| model | seed | fit s | window | walks pass | jogs pass "
-        "| leg amplitude walk / jog | step frequency walk / jog (Hz) |",
-        "|---|---|---|---|---|---|---|---|",
+            rows.append(dict(encoding=encoding, seed=seed, **row))
+            print(f"  {encoding} seed {seed}: {row}", flush=True)
+    cells = [f"{s} {w}" for w in WINDOWS for s in STYLES]
+    total = sum(row[cell] for row in rows for cell in cells)
+    columns = [("encoding", "encoding", "s"), ("seed", "seed", "d")] + [
+        (cell, f"{cell.replace(' ', 's pass, frames ')}", "d") for cell in cells
     ]
-    for row in rows:
-        for window in WINDOWS:
-            walk, jog = (row[window][style] for style in STYLES)
-            lines.append(
-                f"| {row['model']} | {row['seed']} | {row['train_seconds']:.1f} "
-                f"| {window} | {walk['passes']}/{n} | {jog['passes']}/{n} "
-                f"| {spread(walk['amplitude'])} / {spread(jog['amplitude'])} "
-                f"| {spread(walk['frequency'])} / {spread(jog['frequency'])} |"
-            )
-    return "\n".join(lines)
+    table = print_table(
+        rows,
+        columns,
+        title=f"\nSequences passing (of {N_PER_STYLE} per cell): "
+        f"{total} of {len(rows) * len(cells) * N_PER_STYLE} windows",
+    )
+    write_json(
+        "generation_seeds",
+        dict(args=vars(args), rows=rows, passing=total, sequences=details, table=table),
+        args.output,
+    )
+    return rows
 
 
 if __name__ == "__main__":

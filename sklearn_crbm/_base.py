@@ -43,7 +43,7 @@ AIS_STEPS, AIS_CHAINS = 50, 2
 # Draws of the lower layers' hidden units per frame in a stack's bound.
 BOUND_SAMPLES = 10
 # Standard deviation of the jitter added to the previous frame to start the
-# Gibbs chain of a new frame, as in the original code's generation.
+# Gibbs chain of a new frame (the original code's gen.m).
 START_JITTER = 0.01
 
 

@@ -113,6 +113,7 @@ def test_docs_build(html_dir):
         "glossary.html",
         "api.html",
         "benchmarks.html",
+        "what_we_tried.html",
         "auto_examples/index.html",
         "generated/sklearn_crbm.ConditionalRBM.html",
     ]:

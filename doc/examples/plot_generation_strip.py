@@ -11,7 +11,7 @@ the paper's Fig. 3, with the real trial the seed came from for comparison.
 
 The model is trained with the default ``history_noise``: noise on the past
 frames that feed the directed connections, which keeps long generated sequences in
-their style (``benchmarks/generation_styles.py`` measures it; with the paper's
+their style (``benchmarks/paper_generation.py`` measures it; with the paper's
 schedule alone, some training seeds turn every walk into a jog).  The
 generated frames go back to raw joint angles through the preprocessing's exact
 ``inverse_transform`` and to joint positions through the skeleton's forward

@@ -210,7 +210,7 @@ fig.savefig(OUTPUT / "model_selection.png", dpi=90)
 # pose and stay uncertain given the past, more so the more of them there are,
 # and the likelihood charges for that spread while the fills, which use the
 # model's mean, do not.  Training cannot take the spread away without costing
-# the fill-in (``benchmarks/model_selection_diagnostics.py training``).  The
+# the fill-in (see the *What we tried* page of the documentation).  The
 # configuration the search picks fills in within 3 to 10% of the best of the
 # grid.  To choose a model for filling in,
 # score the fill-in itself

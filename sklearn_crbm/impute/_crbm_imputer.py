@@ -38,104 +38,59 @@ class CRBMImputer(BaseMotionImputer):
     """Fill missing channels on-line with a conditional RBM (paper §4.4).
 
     ``fit`` trains a clone of ``estimator`` on complete sequences.
-    ``transform`` then fills the frames of each sequence in time order, as
-    they would arrive from a motion-capture system: frame ``t`` is filled
-    from the already filled frames before it (through the directed
-    connections) and from its own observed channels (through the symmetric
-    ones), never from later frames.  The observed channels are clamped, the
-    missing ones start at their value in the previous frame, and alternating
-    Gibbs sampling follows: hidden units sampled given the frame and its
-    history, visibles set to their mean given the hidden units, ``n_gibbs``
-    times, then one mean-field step (the generation scheme of the original
-    code, with the observed channels held fixed).
+    ``transform`` fills the frames of each sequence in time order, as they
+    would arrive from a motion-capture system: frame ``t`` is filled from the
+    filled frames before it and from its own observed channels, never from
+    later frames.  The observed channels are clamped, the missing ones start
+    at their value in the previous frame, and ``n_gibbs`` alternating Gibbs
+    iterations follow, then one mean-field step (the original code's
+    generation scheme with the observed channels held fixed).
+
+    Read more in the :ref:`User Guide <filling_in>`.
 
     Parameters
     ----------
     estimator : ConditionalRBM or StackedCRBM, default=None
-        The model, cloned and trained by :meth:`fit`.  A model fitted
-        already is used as it is, without training, when wrapped in
-        :class:`sklearn.frozen.FrozenEstimator`:
-        ``CRBMImputer(FrozenEstimator(model))``.  ``None`` means
-        ``ConditionalRBM()``, seeded from ``random_state`` (see there), whose
-        default ``history_noise`` trains on
-        noisy histories so that on-line fills do not drift (see Notes; with
-        :meth:`ConditionalRBM.paper_schedule` the filled upper body of a
-        walk drifts for some training seeds).  Standardise the data first (e.g. with
-        :class:`~sklearn_crbm.preprocessing.StandardScaler`): the visible
-        units have unit variance.
+        The model, cloned and trained by :meth:`fit`; a fitted model wrapped
+        in :class:`sklearn.frozen.FrozenEstimator` is used as it is.  ``None``
+        means ``ConditionalRBM()`` seeded from ``random_state``.  The visible
+        units have unit variance: standardise the data first.
     n_gibbs : int, default=30
         Alternating Gibbs iterations per frame.
     n_draws : int, default=1
-        Number of independent fills averaged by :meth:`transform`: one
-        draw is one sample of the model's on-line fill, the average of many
-        estimates its posterior mean, which has a lower squared error.
+        Number of independent fills that :meth:`transform` averages (an
+        estimate of the posterior mean).
     n_particles : int, default=20
-        Chains per draw.  With more than one, each draw is a particle
-        filter: before every frame, the draw's particles are resampled in
-        proportion to how well each one's past predicts the frame's observed
-        channels, and the draw's fill of the frame is the mean of its
-        particles' fills (see Notes).  ``1`` is the paper's single chain.
-        Mostly the mean of many chains lowers the squared error; with the
-        offset correction, on the 40 cells of
-        ``benchmarks/fillin_baselines.py`` (three random streams each),
-        1, 10, 20 and 40 chains beat every simple baseline in 9, 23-27,
-        26-29 and 27-29 cells.  Twenty cost about twenty times one chain
-        (still several times real time).
+        Chains per draw: a particle filter that, before every frame,
+        resamples the chains by how well each one's past predicts the frame's
+        observed channels, and fills the frame with their mean.  ``1`` is the
+        paper's single chain.
     offset_shrinkage : float or None, default=30.0
-        Correct each fill for the model's systematic error on the sequence
-        at hand (see Notes).  ``None``: no correction (with
-        ``n_particles=1`` and ``observation_gain=1``, the paper's fill-in
-        exactly).  A number ``lam >=
-        0``: a missing entry of channel ``j`` is shifted by ``sum(r) / (n +
-        lam)``, where ``r`` are the channel's one-step residuals (observed
-        value minus the chain's mean-field prediction from its past) over
-        the ``n`` frames of the sequence in which it was observed so far:
-        the mean residual, shrunk towards 0 as if ``lam`` frames of zero
-        residual had been seen.  Binary visibles' fills are probabilities
-        and are kept in [0, 1].  ``30`` suits CMU subject 35 at 30 frames
-        per second (see Notes).
+        Correct the fills for the model's systematic error on the sequence at
+        hand: a missing entry of channel ``j`` is shifted by ``sum(r) / (n +
+        lam)``, ``r`` the channel's one-step residuals over the ``n`` frames
+        in which it was observed so far, ``lam`` this value.  ``None``: no
+        correction.
     observation_gain : float, default=2.5
-        How strongly a frame's observed channels steer the fill of its
-        missing ones (see Notes).  In the Gibbs run the hidden units see an
-        observed channel at ``x_hat + observation_gain * (x - x_hat)``,
-        where ``x`` is its value and ``x_hat`` the chain's one-step
-        prediction of it from its past: its surprise counts
-        ``observation_gain`` times.  ``1`` is the model's own conditional
-        (with ``n_particles=1`` and ``offset_shrinkage=None``, the paper's
-        fill-in exactly); ``0`` ignores the frame's observed values
-        (a pure prediction from the past).  ``2.5`` suits CMU subject 35
-        (see Notes).
+        The hidden units see an observed channel at ``x_hat + g * (x -
+        x_hat)``, ``x_hat`` the chain's one-step prediction of it and ``g``
+        this gain (per channel, see ``observation_weighting``).  ``1`` is the
+        model's own conditional; ``0`` ignores the frame's observed values.
     observation_weighting : {"residual", "uniform"}, default="residual"
-        How ``observation_gain`` is spread over the channels.
         ``"uniform"``: every observed channel gets ``observation_gain``.
         ``"residual"``: channel ``j`` gets ``1 + (observation_gain - 1) *
-        w_j`` (at least 0), with ``w_j = min(m / v_j, 3)``, where ``v_j`` is
-        the variance of the model's one-step residuals of the channel on
-        the training frames (:attr:`residual_variance_`) and ``m`` their
-        median over the channels: a channel the model predicts well (a slow
-        posture channel) speaks up to three times as loud, a fast one whose
-        surprise is mostly noise (a jogging leg) less.  With
-        ``observation_gain=1`` both are the model's own conditional.
+        min(m / v_j, 3)`` (at least 0), ``v_j`` its :attr:`residual_variance_`
+        and ``m`` their median, so well-predicted channels count more.
     missing_values : int, float, str, np.nan or None, default=np.nan
         The placeholder for missing values; all its occurrences are filled.
     random_state : int, RandomState instance or None, default=None
-        Seeds the Gibbs sampling of :meth:`transform`; pass an int for
-        reproducible fills.  A given ``estimator`` keeps its own
-        ``random_state`` for training; with ``estimator=None`` the default
-        ``ConditionalRBM`` is trained with a seed drawn from this one, so the
-        same int gives the same model and the same fills.
+        Seeds the sampling of :meth:`transform` and, with ``estimator=None``,
+        the training of the default model.
     n_jobs : int, default=None
-        Number of jobs filling blocks of sequences in parallel (joblib).
-        Up to 32 sequences are filled together, vectorised, as one block;
-        more are split into near-equal blocks of consecutive sequences,
-        each with its own random stream drawn from ``random_state``.  The
-        split depends on the data only, so the fills are the same for every
-        ``n_jobs``.  ``None`` means 1 unless in a
-        :func:`joblib.parallel_backend` context; ``-1`` means all processors.
+        Number of jobs filling blocks of up to 32 sequences in parallel; the
+        fills are the same for every ``n_jobs``.
     verbose : int, default=0
-        With ``verbose > 0``, :meth:`fit` says what it trains and the model
-        reports its progress every ``verbose`` epochs (the model's own
-        ``verbose``, when that is 0, is set to this value for training).
+        Training progress every ``verbose`` epochs.
 
     Attributes
     ----------
@@ -143,13 +98,11 @@ class CRBMImputer(BaseMotionImputer):
         The fitted clone of ``estimator``, or the model inside a
         ``FrozenEstimator`` (not a copy).
     mean_ : ndarray of shape (`n_features_in_`,)
-        Mean training frame: where the missing channels of the first frame
-        of a sequence start.
+        Mean training frame: where the missing channels of a sequence's first
+        frame start.
     residual_variance_ : ndarray of shape (`n_features_in_`,)
-        Variance of each channel's one-step residuals on the training
-        frames that have a full past: the frame minus the model's
-        ``predict_next``.  ``observation_weighting="residual"`` weights the
-        channels by it.
+        Variance of each channel's one-step residuals (the frame minus the
+        model's ``predict_next``) on the training frames with a full past.
     n_features_in_ : int
         Number of features seen during :term:`fit`.
     feature_names_in_ : ndarray of shape (`n_features_in_`,)
@@ -158,123 +111,22 @@ class CRBMImputer(BaseMotionImputer):
 
     See Also
     --------
+    AutoregressiveImputer : The strong simple baseline.
     NearestNeighborImputer : The paper's baseline.
-    ConditionalRBM : The model.
 
     Notes
     -----
-    *Start of a sequence.*  The first frame of a sequence has no past: its
-    missing channels start at the training mean and the model is run with
-    the frame standing in for its own past (edge padding, as
-    :meth:`ConditionalRBM.transform`), three times over, each time with the
-    latest fill as the past.  Frames ``1`` to ``order - 1`` use the frames
-    they have, the first frame repeated for the rest.
-
-    *Drift, and how to avoid it.*  On-line, each frame is filled given the
-    model's own fills of the frames before it, so fill errors feed back
-    through the directed connections.  A model trained, as in the paper,
-    on clean histories only has never seen a past with its own errors in
-    it and need not correct them: with the upper body of a walk missing,
-    the filled arms can slide into the jogging arm carriage and stay there,
-    for some training seeds and not others, although the same model fills
-    every frame well when given the *true* past.  Train the estimator with
-    noisy histories (``ConditionalRBM(history_noise=0.4)`` for standardised
-    motion) so that it learns to pull a perturbed past back towards the
-    data; on CMU subject 35 this removes the drift for every seed (see
-    ``benchmarks/paper_fillin.py``).
-
-    *Particles.*  A drifting chain also predicts the *observed* channels
-    badly.  With ``n_particles > 1`` every draw is a sequential Monte Carlo
-    filter with the clamped Gibbs run as proposal: before frame ``t`` each
-    particle is weighted by the likelihood of frame ``t``'s observed
-    channels under its own one-step prediction (mean field from its past;
-    Gaussian with the model's unit variance), the particles are resampled
-    (systematic resampling), and each then fills frame ``t`` by clamped
-    Gibbs sampling.  Particles that have drifted are replaced by copies of
-    those that explain the data.  The filter stays on-line: frame ``t``'s
-    fill never changes afterwards.
-
-    *Offset correction.*  Filled from its own past, a model drifts towards
-    its own typical values: on CMU subject 35 (``benchmarks/
-    fillin_baselines.py``) about 40% of the error of a filled upper body is
-    a constant offset of slow posture channels (lower back, thorax, head:
-    the subject's forward lean in this trial), which the model, trained on
-    every trial's posture and on noisy histories, pulls towards the
-    average posture.  Before a channel went missing, the model's one-step
-    predictions of it showed that pull as a residual of constant sign;
-    ``offset_shrinkage`` carries it on, as the posterior mean of a constant
-    offset behind the residuals (Gaussian, with a prior worth ``lam``
-    frames), added to the fill and so fed back into the chain's past.  A
-    fast channel's residuals average out and its correction stays small.
-    With the defaults around ``ConditionalRBM(200, order=3, n_iter=1000)``
-    it lowers the error on most cells of that benchmark; ``lam = 30`` was
-    the best of 0, 10, 30, 100 and 300 on the training trials themselves.
-
-    *Observation gain.*  The model's visible units have unit variance, but
-    its real one-step residuals on standardised motion are about ten times
-    smaller (median variance 0.06 per channel on CMU subject 35), so the
-    model takes the observed channels of a frame for much noisier evidence
-    than they are: filled from the *true* past, the missing channels come
-    out nearly as well without the frame's observed channels as with them
-    (``benchmarks/fillin_baselines.py``, second split, walk, left leg
-    missing, models of seeds 0-2: 3.93-4.35 against 3.85-4.17).  A leg
-    that falls out of step with the observed body is then not pulled back.
-    ``observation_gain=g`` multiplies what the hidden units see of the
-    observed channels' deviation from the chain's one-step prediction by
-    ``g``, a first-order version of conditioning on them with variance
-    ``1 / g`` (the exact tempered conditional couples the hidden units).
-    The prediction, not the chain's current state, is the reference, so
-    the amplified input is fixed during the Gibbs run and cannot
-    oscillate; the observed values themselves are kept.  The first frame
-    of a sequence, with no past, is filled with ``g = 1``.  The same gain
-    on every channel (``observation_weighting="uniform"``, ``g = 2``, the
-    best of 1, 1.5, 2, 2.5 and 3 on the training trials of CMU subject 35)
-    re-anchors the filled leg of a walk to the observed body
-    (``benchmarks/fillin_baselines.py``, second split, walk leg, seeds 0-4:
-    4.43-5.37 against 4.88-6.08 with ``g = 1``) but fills the fast leg of
-    a jog worse (5.09-7.17 against 4.79-5.60): there the observed leg's
-    surprise is mostly noise.  ``observation_weighting="residual"`` gives
-    each channel a gain by how well the model predicts it on the training
-    frames, so that posture channels, predicted well, count most.  With it,
-    on the training trials (models retrained, seeds 0-2, total error),
-    ``g = 1.5, 2, 2.5, 3`` give 1374.6, 1359.1, 1348.9, 1347.7 against
-    1368.3 for the uniform ``g = 2``; 2.5 and 3 tie (better than the
-    uniform gain on 131 and 119 of 186 trial-cells), and 2.5, the smaller
-    step, is the default.
-
-    *Wholly missing frames* are generated from their past alone by the same
-    on-line loop as :meth:`ConditionalRBM.sample`
-    (:func:`~sklearn_crbm._online.run_online`), starting from the previous
-    frame (without ``sample``'s small jitter).  Frames without missing
-    channels are copied and cost nothing.
-
-    *Array API.*  With ``sklearn.set_config(array_api_dispatch=True)``,
-    :meth:`fit`, :meth:`transform` and :meth:`sample` take PyTorch (or
-    array-api-strict, CuPy) arrays and work on their device; the output is in
-    the input's namespace, on its device, in its dtype.  A frozen model must
-    be there already (``sklearn.utils._array_api.move_estimator_to``).  There
-    every sequence advances at every step, drawing frames with nothing
-    missing too (they come back unchanged), so the random numbers, and the
-    fills, differ from numpy's but agree with them in distribution.
-
-    All sequences advance frame by frame together, and so do the
-    ``n_draws * n_particles`` chains: the cost is about ``2 * n_gibbs``
-    matrix products of ``n_draws * n_particles`` rows per frame of the
-    longest sequence.  Memory is ``O(n_draws * n_frames * n_features)``
-    for the output plus the recent past of every chain.
-
-    The estimator may be a :class:`ConditionalRBM` or a
-    :class:`~sklearn_crbm.StackedCRBM`.  With a stack each Gibbs iteration
-    passes the frame up the lower layers (hidden probabilities), takes one
-    alternating step of the top layer and passes the result down as visible
-    means, with the observed channels clamped; every layer's directed
-    connections see that layer's own on-line past (the frame's hidden
-    probabilities in the layer below).  This is the ``"whole_stack"``
-    scheme of :func:`~sklearn_crbm._online.run_online`: the clamped
-    channels live at the bottom, so the frame itself must be the chain's
-    state.  :meth:`StackedCRBM.sample`, with nothing to clamp, runs the
-    chain in the top layer alone and passes it down once (``"top_layer"``,
-    the original two-level code's scheme).
+    The first frame of a sequence has no past: its missing channels start at
+    ``mean_`` and the frame stands in for its own past (edge padding), three
+    times over; frames ``1`` to ``order - 1`` use the past they have.  Wholly
+    missing frames are generated from their past alone.  With
+    ``CRBMImputer(n_particles=1, offset_shrinkage=None, observation_gain=1)``
+    the fill is the paper's.  With a :class:`~sklearn_crbm.StackedCRBM`, each
+    Gibbs iteration passes the frame up the layers and back down, the
+    observed channels clamped at the bottom.  Under
+    ``sklearn.set_config(array_api_dispatch=True)`` the imputer fills arrays
+    of other namespaces on their device; the fills agree with numpy's in
+    distribution, not digit for digit.
 
     References
     ----------

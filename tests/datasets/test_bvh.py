@@ -259,90 +259,39 @@ def test_write_bvh_checks_its_input(tmp_path, small_bvh):
 
 
 # ------------------------------------------------------------- malformed
-def _bad_bvh(tmp_path, old, new):
+# A fault in SMALL_BVH (old -> new): the line and the words of the error.
+MALFORMED = {
+    "no hierarchy": ("HIERARCHY", "HIERARCHIE", 1, "'HIERARCHY'"),
+    "number in offset": ("OFFSET 0 10 0", "OFFSET 0 1O 0", 8, "'1O'"),
+    "unknown channel": ("CHANNELS 1 Xrotation", "CHANNELS 1 Wrotation", 18, "'Wrotation'"),
+    "unclosed brace": ("    }\n  }\n}\nMOTION", "    }\n  }\nMOTION", 23, "file ends"),
+    "fractional frame count": ("Frames: 2", "Frames: 2.5", 26, "whole number"),
+    "no frame count": ("Frames: 2", "Frames:", 26, "one number"),
+    "zero frame time": ("Frame Time: 0.04", "Frame Time: 0", 27, "positive frame time"),
+    "values in a frame": (
+        "1 2 3 0 0 0 0 0 0 0", "1 2 3 0 0 0 0 0 0", 28, "9 values, expected 10"
+    ),
+    "truncated motion": ("1 2 4 90 0 0 0 0 0 90\n", "", 28, "truncated"),
+    "number in motion": ("1 2 4 90", "1 2 4 9O", 29, "'9O'"),
+    "more frames than announced": ("Frames: 2", "Frames: 1", 29, "more frames"),
+    "no motion": ("MOTION", "MOTOR", 29, "'MOTION'"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "old, new, lineno, words", MALFORMED.values(), ids=list(MALFORMED)
+)
+def test_malformed_bvh_names_the_line(tmp_path, old, new, lineno, words):
     assert old in SMALL_BVH
     path = tmp_path / "bad.bvh"
     path.write_text(SMALL_BVH.replace(old, new, 1))
-    return path
-
-
-def _lineno(path, fragment):
-    lines = path.read_text().splitlines()
-    return next(i for i, line in enumerate(lines, start=1) if fragment in line)
-
-
-def test_bvh_missing_hierarchy(tmp_path):
-    path = _bad_bvh(tmp_path, "HIERARCHY", "HIERARCHIE")
-    with pytest.raises(ValueError, match=_line_error(path, 1) + ".*'HIERARCHY'"):
+    message = _line_error(path, lineno) + ".*" + re.escape(words)
+    with pytest.raises(ValueError, match=message):
         read_bvh(path)
+
+
+def test_skeleton_from_malformed_bvh_names_the_line(tmp_path):
+    path = tmp_path / "bad.bvh"
+    path.write_text(SMALL_BVH.replace("HIERARCHY", "HIERARCHIE"))
     with pytest.raises(ValueError, match=_line_error(path, 1)):
         Skeleton.from_bvh(path)
-
-
-def test_bvh_bad_number_in_offset(tmp_path):
-    path = _bad_bvh(tmp_path, "OFFSET 0 10 0", "OFFSET 0 1O 0")
-    lineno = _lineno(path, "1O")
-    with pytest.raises(ValueError, match=_line_error(path, lineno) + ".*'1O'"):
-        read_bvh(path)
-
-
-def test_bvh_bad_number_in_motion(tmp_path):
-    path = _bad_bvh(tmp_path, "1 2 4 90", "1 2 4 9O")
-    with pytest.raises(ValueError, match=_line_error(path, 29) + ".*'9O'"):
-        read_bvh(path)
-
-
-def test_bvh_frame_with_wrong_number_of_values(tmp_path):
-    path = _bad_bvh(tmp_path, "1 2 3 0 0 0 0 0 0 0", "1 2 3 0 0 0 0 0 0")
-    with pytest.raises(
-        ValueError, match=_line_error(path, 28) + ".*9 values, expected 10"
-    ):
-        read_bvh(path)
-
-
-def test_bvh_truncated_motion(tmp_path):
-    path = _bad_bvh(tmp_path, "1 2 4 90 0 0 0 0 0 90\n", "")
-    with pytest.raises(ValueError, match=_line_error(path, 28) + ".*truncated"):
-        read_bvh(path)
-
-
-def test_bvh_more_frames_than_announced(tmp_path):
-    path = _bad_bvh(tmp_path, "Frames: 2", "Frames: 1")
-    with pytest.raises(ValueError, match=_line_error(path, 29) + ".*more frames"):
-        read_bvh(path)
-
-
-def test_bvh_missing_motion(tmp_path):
-    path = _bad_bvh(tmp_path, "MOTION", "MOTOR")
-    with pytest.raises(ValueError, match=_line_error(path, 29) + ".*'MOTION'"):
-        read_bvh(path)
-
-
-def test_bvh_unknown_channel(tmp_path):
-    path = _bad_bvh(tmp_path, "CHANNELS 1 Xrotation", "CHANNELS 1 Wrotation")
-    lineno = _lineno(path, "Wrotation")
-    with pytest.raises(ValueError, match=_line_error(path, lineno) + ".*'Wrotation'"):
-        read_bvh(path)
-
-
-def test_bvh_unclosed_brace(tmp_path):
-    path = _bad_bvh(tmp_path, "    }\n  }\n}\nMOTION", "    }\n  }\nMOTION")
-    with pytest.raises(ValueError, match=_line_error(path, 23) + ".*file ends"):
-        read_bvh(path)
-
-
-def test_bvh_bad_frame_time(tmp_path):
-    path = _bad_bvh(tmp_path, "Frame Time: 0.04", "Frame Time: 0")
-    with pytest.raises(
-        ValueError, match=_line_error(path, 27) + ".*positive frame time"
-    ):
-        read_bvh(path)
-
-
-def test_bvh_bad_frame_count(tmp_path):
-    path = _bad_bvh(tmp_path, "Frames: 2", "Frames: 2.5")
-    with pytest.raises(ValueError, match=_line_error(path, 26) + ".*whole number"):
-        read_bvh(path)
-    path = _bad_bvh(tmp_path, "Frames: 2", "Frames:")
-    with pytest.raises(ValueError, match=_line_error(path, 26) + ".*one number"):
-        read_bvh(path)

@@ -1,0 +1,185 @@
+"""The paper's generation experiments: styles (§4.1), stacks (§4.2, §5), transitions (§4.3).
+
+``styles``: each model, per training seed, generates 300 frames from each of
+6 seeds of real frames per style (``MotionPipeline.style_windows``); the last
+100 frames of every sequence are judged by ``metrics.judge_generated_motion``
+(the nearest real style on speed and step frequency; died out, stalled,
+blown up).  A seed passes the paper's bar when, for every style, at least 5
+of 6 sequences keep their style, none blows up and at most one dies out.
+Models (``--models``), each trained on all the data of ``--datasets``:
+
+- ``paper``: ``ConditionalRBM.paper_schedule(n_iter=1000)`` (clean
+  histories, shuffled minibatches);
+- ``defaults``: ``ConditionalRBM()``;
+- ``stacked``: the two-level model of §5, ``StackedCRBM((200, 200),
+  order=3, n_iter=500)``, generating top-down as the original ``gen2.m``;
+- ``stacked-noisy``: the same with ``history_noise=0.4`` in both layers.
+
+Data: ``cmu`` (the 23 walks and 10 jogs of CMU subject 35, the package's
+encoding) and ``mit`` (Taylor's MIT walks, the data of the original two-level
+demo; §4.2's walk/jog file is not public).
+
+``transitions`` (§4.3): the ``defaults`` model of CMU 35 generates 12
+sequences of 1200 frames (half walk-, half jog-seeded) with Gaussian noise of
+standard deviation ``hidden_noise`` on the hidden biases; every window of 60
+frames (hop 30) is labelled walk, jog, still (died out or stalled) or blown,
+and switches between walk and jog are counted per direction.
+
+Run from the repository root::
+
+    python benchmarks/paper_generation.py
+    python benchmarks/paper_generation.py --parts transitions --noise 0 2 4
+"""
+
+import numpy as np
+from _common import MotionCorpus, announce, cached_fit, parser, print_table, write_json
+
+from sklearn_crbm import ConditionalRBM, StackedCRBM
+
+MODELS = {
+    "paper": lambda seed: ConditionalRBM.paper_schedule(n_iter=1000, random_state=seed),
+    "defaults": lambda seed: ConditionalRBM(random_state=seed),
+    "stacked": lambda seed: StackedCRBM(
+        (200, 200), order=3, n_iter=500, random_state=seed
+    ),
+    "stacked-noisy": lambda seed: StackedCRBM(
+        (200, 200), order=3, n_iter=500, history_noise=0.4, random_state=seed
+    ),
+}
+N_PER_STYLE, N_FRAMES = 6, 300
+WINDOW, HOP = 60, 30
+
+
+def fitted(corpus, model_name, seed):
+    model = MODELS[model_name](seed)
+    return cached_fit(model, corpus.Z.astype(np.float32), corpus.ids)[0]
+
+
+def styles_row(corpus, model, seed):
+    """Counts per style over the last 100 of 300 generated frames."""
+    history, expected = corpus.seed_windows(model, N_PER_STYLE, seed)
+    generated = model.sample(N_FRAMES, history=history, random_state=seed)
+    ids = np.repeat(np.arange(len(expected)), N_FRAMES)
+    verdict = corpus.judge(generated, ids, expected, last_frames=100)
+    row, passes = {}, True
+    for style in corpus.style_names:
+        mine = expected == style
+        counts = {
+            k: int(verdict[k][mine].sum())
+            for k in ("keeps", "dead", "stalled", "blown")
+        }
+        row.update({f"{style} {k}": v for k, v in counts.items()})
+        row[f"{style} speed"] = float(np.mean(verdict.speed[mine]))
+        row[f"{style} Hz"] = float(np.nanmean(verdict.frequency[mine]))
+        passes &= counts["keeps"] >= N_PER_STYLE - 1
+        passes &= counts["blown"] == 0 and counts["dead"] <= 1
+    row["passes"] = "yes" if passes else "no"
+    return row
+
+
+def window_labels(corpus, generated, n_sequences, n_frames):
+    """walk / jog / still / blown for every window of every sequence."""
+    starts = np.arange(0, n_frames - WINDOW + 1, HOP)
+    rows = (starts[:, None] + np.arange(WINDOW)).ravel()
+    windows = generated.reshape(n_sequences, n_frames, -1)[:, rows]
+    windows = windows.reshape(n_sequences * len(starts) * WINDOW, -1)
+    verdict = corpus.judge(
+        windows, np.repeat(np.arange(n_sequences * len(starts)), WINDOW)
+    )
+    labels = np.where(verdict.dead | verdict.stalled, "still", verdict.style)
+    labels = np.where(verdict.blown, "blown", labels)
+    return labels.reshape(n_sequences, len(starts))
+
+
+def transitions_row(corpus, model, seed, noise, n_frames=1200):
+    history, _ = corpus.seed_windows(model, N_PER_STYLE, seed)
+    generated = model.sample(
+        n_frames, history=history, hidden_noise=noise, random_state=seed
+    )
+    labels = window_labels(corpus, generated, len(history), n_frames)
+    switches = {"walk to jog": 0, "jog to walk": 0}
+    for row in labels:
+        moving = [label for label in row if label in ("walk", "jog")]
+        for a, b in zip(moving[:-1], moving[1:], strict=True):
+            if a != b:
+                switches[f"{a} to {b}"] += 1
+    shares = {s: float(np.mean(labels == s)) for s in ("walk", "jog", "still", "blown")}
+    return dict(hidden_noise=noise, seed=seed, **switches, **shares)
+
+
+def main(argv=None):
+    p = parser(__doc__, seeds=(0, 1, 2))
+    p.add_argument(
+        "--parts",
+        nargs="+",
+        default=["styles", "transitions"],
+        choices=["styles", "transitions"],
+    )
+    p.add_argument(
+        "--datasets", nargs="+", default=["cmu", "mit"], choices=["cmu", "mit"]
+    )
+    p.add_argument("--models", nargs="+", default=list(MODELS), choices=MODELS)
+    p.add_argument("--noise", type=float, nargs="+", default=[0, 1, 2, 2.5, 3, 4])
+    args = p.parse_args(argv)
+    announce()
+    corpora = {name: MotionCorpus(args.data_home, name) for name in args.datasets}
+    results = {}
+    if "styles" in args.parts:
+        rows = []
+        for name, corpus in corpora.items():
+            for model_name in args.models:
+                if name == "mit" and not model_name.startswith("stacked"):
+                    continue  # the MIT data is the two-level model's
+                for seed in args.seeds:
+                    row = styles_row(corpus, fitted(corpus, model_name, seed), seed)
+                    rows.append(dict(data=name, model=model_name, seed=seed, **row))
+                    print(f"  {name} {model_name} seed {seed}: {row}", flush=True)
+        columns = [
+            ("data", "data", "s"),
+            ("model", "model", "s"),
+            ("seed", "seed", "d"),
+        ]
+        for style in ("walk", "jog"):
+            columns += [
+                (f"{style} {k}", f"{style}s {k}", "d")
+                for k in ("keeps", "dead", "stalled", "blown")
+            ]
+            columns += [
+                (f"{style} speed", f"{style} speed", ".2f"),
+                (f"{style} Hz", f"{style} Hz", ".2f"),
+            ]
+        results["styles"] = dict(
+            rows=rows,
+            table=print_table(
+                rows,
+                [*columns, ("passes", "passes", "s")],
+                title=f"\n§4.1, §5: {N_PER_STYLE} sequences per style, last 100 of {N_FRAMES} frames",
+            ),
+        )
+    if "transitions" in args.parts:
+        corpus = corpora.get("cmu") or MotionCorpus(args.data_home, "cmu")
+        rows = [
+            transitions_row(corpus, fitted(corpus, "defaults", seed), seed, noise)
+            for noise in args.noise
+            for seed in args.seeds
+        ]
+        columns = [
+            ("hidden_noise", "hidden_noise", "g"),
+            ("seed", "seed", "d"),
+            ("walk to jog", "walk to jog", "d"),
+            ("jog to walk", "jog to walk", "d"),
+        ]
+        columns += [(s, f"share {s}", ".2f") for s in ("walk", "jog", "still", "blown")]
+        results["transitions"] = dict(
+            rows=rows,
+            table=print_table(
+                rows,
+                columns,
+                title=f"\n§4.3: {2 * N_PER_STYLE} sequences of 1200 frames, windows of {WINDOW}",
+            ),
+        )
+    write_json("paper_generation", dict(args=vars(args), **results), args.output)
+
+
+if __name__ == "__main__":
+    main()
