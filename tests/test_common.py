@@ -26,11 +26,14 @@ from sklearn_crbm import (
     ConditionalRBM,
     CRBMImputer,
     ExpMapEncoder,
+    FactoredCRBM,
+    LabelledCRBM,
     NearestNeighborImputer,
     RootRelativeEncoder,
     StackedCRBM,
     StandardScaler,
 )
+from sklearn_crbm.metrics import StyleJudge
 from sklearn_crbm.preprocessing import MotionPipeline
 
 ROW_DEPENDENCE = (
@@ -60,6 +63,20 @@ def _tested_estimators():
         random_state=0,
     )
     yield StackedCRBM((8, 6), order=3, n_iter=5, random_state=0)
+    yield FactoredCRBM(
+        8, n_factors=4, n_style_features=3, order=2, cd_steps=1, n_iter=3, n_gibbs=3
+    )
+    yield FactoredCRBM(
+        8,
+        n_factors=4,
+        n_style_features=3,
+        order=2,
+        shared_style_weights=False,
+        cd_steps=1,
+        n_iter=3,
+        n_gibbs=3,
+    )
+    yield LabelledCRBM(8, order=2, n_iter=3, n_gibbs=3)
     yield CRBMImputer(
         ConditionalRBM(n_components=8, n_iter=5, random_state=0),
         n_gibbs=5,
@@ -87,6 +104,9 @@ def _tested_estimators():
     yield RootRelativeEncoder(channels=("tx", "tz"))
     yield RootRelativeEncoder(channels=("ey",))
     yield StandardScaler()
+    # with windows of one frame every row is judged on its own, so every
+    # check of a classifier applies
+    yield StyleJudge(window=1, stride=1)
     yield MotionPipeline(
         [
             ("scale", StandardScaler()),
@@ -114,7 +134,9 @@ def _expected_failed_checks(estimator):
             "check_methods_sample_order_invariance": ROW_DEPENDENCE,
             "check_fit2d_1sample": ONE_FRAME,
         }
-    if isinstance(estimator, ConditionalRBM | StackedCRBM):
+    if isinstance(
+        estimator, ConditionalRBM | StackedCRBM | FactoredCRBM | LabelledCRBM
+    ):
         return {
             "check_methods_subset_invariance": ROW_DEPENDENCE,
             "check_methods_sample_order_invariance": ROW_DEPENDENCE,
@@ -190,22 +212,8 @@ def test_sklearn_compatible_estimator(estimator, check):
     check(estimator)
 
 
-# MotionPipeline.fit_transform is defined outright, so with invalid steps it
-# reaches Pipeline's available_if guard (AttributeError) before validation.
-FIT_TRANSFORM_UNGUARDED = pytest.mark.xfail(
-    strict=True, reason="MotionPipeline.fit_transform bypasses Pipeline's guard"
-)
-
-
 @pytest.mark.parametrize(
-    "estimator",
-    [
-        pytest.param(e, marks=FIT_TRANSFORM_UNGUARDED)
-        if isinstance(e, MotionPipeline)
-        else e
-        for e in _tested_estimators()
-    ],
-    ids=lambda e: type(e).__name__,
+    "estimator", list(_tested_estimators()), ids=lambda e: type(e).__name__
 )
 def test_param_validation(estimator):
     check_param_validation(type(estimator).__name__, estimator)

@@ -93,11 +93,14 @@ class MotionPipeline(Pipeline):
 
     def fit(self, X, y=None, **params):
         _check_routing(params)
+        self._validate_params()  # the steps, before the up axis reads them
         self._check_up_axis(X)
         return super().fit(X, y, **params)
 
+    @available_if(Pipeline._can_fit_transform)
     def fit_transform(self, X, y=None, **params):
         _check_routing(params)
+        self._validate_params()
         self._check_up_axis(X)
         return super().fit_transform(X, y, **params)
 

@@ -7,7 +7,6 @@ from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.base import clone
 from sklearn.utils.estimator_checks import (
     check_param_validation,
-    parametrize_with_checks,
 )
 
 from sklearn_crbm.datasets import bone_columns, load_bandai_walks
@@ -174,14 +173,6 @@ def test_input_errors(sine_judge):
         judge.score(X, y, sequence_ids=ids, sample_weight=np.ones(len(X)))
     with pytest.raises(ValueError, match="480 frames; give one label per frame"):
         judge.score(X, y[:-1], sequence_ids=ids)
-
-
-# ------------------------------------------------------ scikit-learn's checks
-# With windows of one frame every row is judged on its own, so every check
-# of a classifier applies.
-@parametrize_with_checks([StyleJudge(window=1, stride=1)])
-def test_sklearn_compatible_estimator(estimator, check):
-    check(estimator)
 
 
 def test_param_validation():
