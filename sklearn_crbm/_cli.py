@@ -1,8 +1,9 @@
-"""Command line: ``python -m sklearn_crbm {demo,fetch,fit,sample}``.
+"""Command line: ``python -m sklearn_crbm {demo,fetch,fit,sample,styles}``.
 
 Argument parsing and printing only: the commands' arguments are listed in
-:mod:`._cli_options`, the demo lives in :mod:`._demo`, and everything
-measured or generated is done by the library.
+:mod:`._cli_options`, the demo lives in :mod:`._demo`, the styles command in
+:mod:`._style_demo`, and everything measured or generated is done by the
+library.
 """
 
 import argparse
@@ -18,10 +19,14 @@ from sklearn.utils import Bunch
 from ._cli_options import COMMANDS
 from ._crbm import ConditionalRBM
 from ._demo import run_demo as _run_demo
+from ._factored import FactoredCRBM
+from ._style_demo import run_styles as _run_styles
 from .datasets import (
+    fetch_bandai_walks,
     fetch_cmu35,
     fetch_mit_walk,
     get_data_home,
+    load_bandai_walks,
     load_cmu35,
     read_amc_folder,
     read_bvh_folder,
@@ -89,16 +94,21 @@ def _model_from_args(args):
     )
 
 
-def _load_cmu35(data_home, subset):
+def _load(load, data_home, what, fetch_options="", **kwargs):
+    """``load(data_home, **kwargs)``, or an error saying how to fetch ``what``."""
     try:
-        return load_cmu35(data_home, subset=subset)
+        return load(data_home, **kwargs)
     except FileNotFoundError as exc:
         home = get_data_home(data_home)
         raise FileNotFoundError(
-            f"{exc}\nThe CMU subject 35 data is not in {home}. Download it with\n"
-            f"    python -m sklearn_crbm fetch --data-home {home}\n"
+            f"{exc}\n{what} not in {home}. Download it with\n"
+            f"    python -m sklearn_crbm fetch{fetch_options} --data-home {home}\n"
             "or point --data-home (or $SKLEARN_CRBM_DATA) at a folder that holds it."
         ) from None
+
+
+def _load_cmu35(data_home, subset):
+    return _load(load_cmu35, data_home, "The CMU subject 35 data is", subset=subset)
 
 
 def run_demo(args):
@@ -112,10 +122,15 @@ def run_demo(args):
 def run_fetch(args):
     home = get_data_home(args.data_home)
     existed = home.exists()
+    fetchers = {
+        "cmu35": fetch_cmu35,
+        "mit": fetch_mit_walk,
+        "bandai": fetch_bandai_walks,
+    }
     print(f"downloading into {home}")
     try:
-        fetch_cmu35(home)
-        fetch_mit_walk(home)
+        for name in dict.fromkeys(args.dataset or ["cmu35", "mit"]):
+            fetchers[name](home)
     except BaseException:
         if not existed:  # everything in it is this command's partial download
             shutil.rmtree(home, ignore_errors=True)
@@ -223,4 +238,30 @@ def _seeds(saved, args):
     return windows[rng.integers(len(windows), size=args.n_sequences)]
 
 
-_RUNS = {"demo": run_demo, "fetch": run_fetch, "fit": run_fit, "sample": run_sample}
+def run_styles(args):
+    walks = _load(
+        load_bandai_walks,
+        args.data_home,
+        "The Bandai Namco walks are",
+        " --dataset bandai",
+    )
+    model = FactoredCRBM(
+        args.n_components,
+        n_factors=args.n_factors,
+        n_style_features=args.n_style_features,
+        order=args.order,
+        n_iter=args.n_iter,
+        n_gibbs=args.n_gibbs,
+        random_state=args.seed,
+        verbose=max(1, args.n_iter // 10),
+    )
+    return _run_styles(args, walks, model)
+
+
+_RUNS = {
+    "demo": run_demo,
+    "fetch": run_fetch,
+    "fit": run_fit,
+    "sample": run_sample,
+    "styles": run_styles,
+}

@@ -4,14 +4,17 @@ import tempfile
 from pathlib import Path
 
 from ._crbm import ConditionalRBM
+from ._factored import FactoredCRBM
 
-__all__ = ["COMMANDS", "DEMO_OUTPUT"]
+__all__ = ["COMMANDS", "DEMO_OUTPUT", "STYLES_OUTPUT"]
 
-# The demo writes here unless --output says otherwise: never into the current
-# folder, which in a checkout is the repository.
+# The demo and the styles command write here unless --output says otherwise:
+# never into the current folder, which in a checkout is the repository.
 DEMO_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_demo"
-# The model options default to the estimator's own defaults.
+STYLES_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_styles"
+# The model options default to the estimators' own defaults.
 _DEFAULTS = ConditionalRBM()
+_FACTORED = FactoredCRBM()
 
 
 def _option(*flags, help, **settings):
@@ -26,6 +29,9 @@ _DATA_HOME = _option(
 )
 _N_FRAMES = _option(
     "--n-frames", type=int, default=300, help="frames generated per sequence"
+)
+_SEED = _option(
+    "--seed", type=int, default=0, help="random seed of training and sampling"
 )
 _MODEL_OPTIONS = [
     _option("--n-components", type=int, default=200, help="hidden units of the CRBM"),
@@ -53,7 +59,46 @@ _MODEL_OPTIONS = [
     _option(
         "--n-iter", type=int, default=1000, help="training epochs (the paper: 4000)"
     ),
-    _option("--seed", type=int, default=0, help="random seed of training and sampling"),
+    _SEED,
+]
+_FACTORED_OPTIONS = [
+    _option(
+        "--n-components",
+        type=int,
+        default=_FACTORED.n_components,
+        help="hidden units of the factored CRBM",
+    ),
+    _option(
+        "--n-factors",
+        type=int,
+        default=_FACTORED.n_factors,
+        help="factors of each kind (autoregressive, past-to-hidden, undirected)",
+    ),
+    _option(
+        "--n-style-features",
+        type=int,
+        default=_FACTORED.n_style_features,
+        help="real-valued style features the labels map to",
+    ),
+    _option(
+        "--order",
+        type=int,
+        default=_FACTORED.order,
+        help="past frames each frame depends on",
+    ),
+    _option(
+        "--n-iter",
+        type=int,
+        default=_FACTORED.n_iter,
+        help="training epochs (the released code: 200)",
+    ),
+    _option(
+        "--n-gibbs",
+        type=int,
+        default=_FACTORED.n_gibbs,
+        help="Gibbs iterations per generated frame",
+    ),
+    _SEED,
 ]
 
 
@@ -103,9 +148,20 @@ COMMANDS = {
     "fetch": (
         "download CMU 35 and the MIT walking data",
         "Download CMU subject 35 (ASF/AMC, the paper's 33 walking and jogging "
-        "trials) and Taylor's MIT walking data into the data folder, checking "
-        "every file's SHA-256.",
-        [_DATA_HOME],
+        "trials) and Taylor's MIT walking data into the data folder, or the "
+        "data sets named with --dataset, checking every file's SHA-256.",
+        [
+            _DATA_HOME,
+            _option(
+                "--dataset",
+                action="append",
+                choices=["cmu35", "mit", "bandai"],
+                help="download this data set (repeat for several): cmu35, "
+                "mit (Taylor's MIT walking data) or bandai (the Bandai Namco "
+                "walks in seven styles, 15 MB, CC BY-NC 4.0, for the styles "
+                "command); default: cmu35 and mit",
+            ),
+        ],
     ),
     "fit": (
         "train preprocessing + CRBM on motion files and save it",
@@ -176,6 +232,67 @@ COMMANDS = {
                 type=Path,
                 default=Path("generated"),
                 help="prefix of the files written (PREFIX_0.bvh, PREFIX_1.bvh, ...)",
+            ),
+        ],
+    ),
+    "styles": (
+        "many styles from one factored CRBM: BVH files, strips, a judge",
+        "Train a FactoredCRBM (Taylor & Hinton, ICML 2009) on the Bandai "
+        "Namco walks in seven styles, generate a walk in every style, a "
+        "50/50 blend of two styles and a transition from one style to "
+        "another half-way, all seeded with real frames of a normal walk, "
+        "and write them as BVH files with a skeleton strip of each and a "
+        "plot of the style judge's probabilities over the transition. "
+        "Prints a table of how a StyleJudge trained on the real takes sees "
+        "every style: the share of 2-s windows judged as the style asked "
+        "for, and the leg amplitude and step frequency against the real "
+        "takes. The defaults train for several minutes; fetch the data "
+        "first with 'fetch --dataset bandai'.",
+        [
+            _DATA_HOME,
+            *_FACTORED_OPTIONS,
+            _option(
+                "--output",
+                type=Path,
+                default=STYLES_OUTPUT,
+                help="folder for the BVH files and the figures",
+            ),
+            _option(
+                "--n-frames",
+                type=int,
+                default=600,
+                help="frames generated per sequence (at least 120)",
+            ),
+            _option(
+                "--n-sequences",
+                type=int,
+                default=3,
+                help="sequences generated per style, blend and transition: the "
+                "table judges them all, the first is written",
+            ),
+            _option(
+                "--seed-style",
+                default="normal",
+                help="every sequence starts from real frames of this style",
+            ),
+            _option(
+                "--blend",
+                nargs=2,
+                metavar="STYLE",
+                default=["elderly", "youthful"],
+                help="the two styles blended 50/50",
+            ),
+            _option(
+                "--transition",
+                nargs=2,
+                metavar="STYLE",
+                default=["active", "elderly"],
+                help="the style at the start and the style from half-way on",
+            ),
+            _option(
+                "--no-figures",
+                action="store_true",
+                help="skip the figures (the BVH files are still written)",
             ),
         ],
     ),

@@ -1,17 +1,30 @@
 """The command line: the demo, fetch, fit and sample, help and error messages."""
 
 import argparse
+import io
 import sys
 import tempfile
+from contextlib import redirect_stdout
 from pathlib import Path
 
 import numpy as np
 import pytest
 import sklearn
+from numpy.testing import assert_array_equal
 
-from sklearn_crbm import _cli, _cli_options
+from sklearn_crbm import _cli, _cli_options, _style_demo
 from sklearn_crbm._cli import main
-from sklearn_crbm.datasets import load_cmu35, make_walker, read_amc, read_bvh, write_bvh
+from sklearn_crbm.datasets import (
+    bone_columns,
+    load_bandai_walks,
+    load_cmu35,
+    make_walker,
+    read_amc,
+    read_bvh,
+    write_bvh,
+)
+from sklearn_crbm.metrics import StyleJudge
+from sklearn_crbm.preprocessing import make_motion_preprocessor
 
 TINY = ["--n-components", "12", "--n-iter", "3"]
 
@@ -113,10 +126,11 @@ def test_demo_writes_the_motion_without_figures(
         assert "matplotlib is not installed" in out
 
 
-def test_demo_writes_outside_the_current_folder_by_default():
-    output = _cli._parser().parse_args(["demo"]).output
-    assert output == _cli_options.DEMO_OUTPUT
-    assert output == Path(tempfile.gettempdir()) / "sklearn_crbm_demo"
+@pytest.mark.parametrize("command", ["demo", "styles"])
+def test_demo_writes_outside_the_current_folder_by_default(command):
+    output = _cli._parser().parse_args([command]).output
+    assert output == Path(tempfile.gettempdir()) / f"sklearn_crbm_{command}"
+    assert output in (_cli_options.DEMO_OUTPUT, _cli_options.STYLES_OUTPUT)
     assert Path.cwd().resolve() not in output.resolve().parents
 
 
@@ -268,3 +282,185 @@ def test_missing_data_says_how_to_fetch(tmp_path, capsys):
 def test_no_command_prints_help(capsys):
     assert main([]) == 2
     assert "demo" in capsys.readouterr().out
+
+
+# -- styles: many styles from one FactoredCRBM on the Bandai walks ------------
+
+STYLES = ["active", "elderly", "exhausted", "feminine", "masculine", "normal"]
+STYLES += ["youthful"]
+STYLES_TINY = ["--n-components", "16", "--n-factors", "8", "--n-style-features"]
+STYLES_TINY += ["4", "--n-iter", "2", "--n-frames", "240", "--n-gibbs", "3"]
+WRITTEN = STYLES + ["blend_elderly_youthful", "transition_active_elderly"]
+
+
+def styles_args(data_home, output, *extra):
+    return ["styles", "--data-home", str(data_home), "--output", str(output)] + [
+        *STYLES_TINY,
+        *extra,
+    ]
+
+
+@pytest.fixture(scope="module")
+def styles_run(data_home, tmp_path_factory):
+    """One tiny run of the styles command: ``(status, stdout, output folder)``."""
+    output = tmp_path_factory.mktemp("styles")
+    printed = io.StringIO()
+    with redirect_stdout(printed):
+        status = main(styles_args(data_home, output, "--n-sequences", "1"))
+    return status, printed.getvalue(), output
+
+
+def test_styles_writes_every_style_a_blend_and_a_transition(styles_run, data_home):
+    status, out, output = styles_run
+    assert status == 0
+    expected = sorted(
+        f"{name}{suffix}" for name in WRITTEN for suffix in (".bvh", ".png")
+    )
+    assert sorted(p.name for p in output.iterdir()) == expected
+    walks = load_bandai_walks(data_home)
+    for name in WRITTEN:
+        raw = _read_raw_channels(output / f"{name}.bvh", walks)
+        assert raw.shape == (240, walks.data.shape[1]) and np.isfinite(raw).all()
+        assert (output / f"{name}.png").stat().st_size > 1000
+    assert f"wrote to {output}: active.bvh" in out
+
+
+def _read_raw_channels(path, walks):
+    """A written BVH file in the channels of the Bandai files.
+
+    The file keeps every rotation and the root's position; the other joints'
+    position channels, constant in the Bandai files, are its offsets.
+    """
+    _, data, names, rate = read_bvh(path)
+    assert rate == 30.0
+    columns = [list(walks.feature_names).index(name) for name in names]
+    raw = np.tile(walks.data[0], (len(data), 1))
+    assert np.ptp(np.delete(walks.data, columns, axis=1), axis=0).max() == 0
+    raw[:, columns] = data
+    return raw
+
+
+def _table_rows(out):
+    """``{style: row}`` of the printed table, numbers parsed."""
+    rows = {}
+    for line in out.splitlines():
+        words = line.replace("%", "").replace("(", "").replace(")", "").split()
+        if len(words) == 6 and words[0] in STYLES:
+            rows[words[0]] = [float(w.replace("-", "nan")) for w in words[1:]]
+    return rows
+
+
+def test_styles_table_is_the_judge_on_the_written_files(styles_run, data_home):
+    """Each row, recomputed from the BVH file read back (no pipeline shared)."""
+    _, out, output = styles_run
+    walks = load_bandai_walks(data_home)
+    labels = walks.target_names[walks.target]
+    with sklearn.config_context(enable_metadata_routing=True):
+        pre = make_motion_preprocessor(walks.skeleton)
+        Z = pre.fit_transform(walks.data, sequence_ids=walks.sequence_ids)
+    legs = bone_columns(pre.get_feature_names_out(), _style_demo.LEGS)
+    judge = StyleJudge(legs=legs).fit(Z, labels, sequence_ids=walks.sequence_ids)
+    rows = _table_rows(out)
+    assert sorted(rows) == STYLES
+    for k, style in enumerate(STYLES):
+        generated = pre.transform(_read_raw_channels(output / f"{style}.bvh", walks))
+        verdict = judge.verdict(generated, style)
+        judged = verdict.starts >= 100  # the windows from frame 100 on
+        assert judged.sum() == 6  # starts 105, 120, ..., 180
+        share, alive, amplitude, frequency, real = rows[style]
+        assert share == round(100 * verdict.correct[judged].mean())
+        assert alive == round(100 * verdict.alive[judged].mean())
+        assert amplitude == pytest.approx(
+            np.median(verdict.amplitude_ratio[judged]), abs=0.006
+        )
+        real_frequency = judge.reference_frequency_[k] * 30.0
+        assert real == pytest.approx(real_frequency, abs=0.006)
+        ratio = verdict.frequency_ratio[judged]
+        if np.isfinite(ratio).any():
+            median = np.median(ratio[np.isfinite(ratio)])
+            assert frequency == pytest.approx(median * real_frequency, abs=0.006)
+        else:  # legs that do not move
+            assert np.isnan(frequency)
+
+
+def test_styles_transition_is_judged_before_and_after_the_switch(styles_run):
+    _, out, _ = styles_run
+    (line,) = [x for x in out.splitlines() if x.startswith("transition active")]
+    assert "at frame 120: windows before it judged as active: " in line
+    assert "windows after it judged as elderly: " in line
+    (line,) = [x for x in out.splitlines() if x.startswith("blend elderly + youthful")]
+    assert "of the windows judged as one of the two (elderly " in line
+
+
+def test_style_requests_weights():
+    classes = ["a", "b", "c"]
+    requests = _style_demo.style_requests(
+        classes, 6, blend=("c", "a"), transition=("b", "c")
+    )
+    assert list(requests) == ["a", "b", "c", "blend_c_a", "transition_b_c"]
+    for k, style in enumerate(classes):
+        assert_array_equal(requests[style], np.tile(np.eye(3)[k], (6, 1)))
+    assert_array_equal(requests["blend_c_a"], np.tile([0.5, 0, 0.5], (6, 1)))
+    switch = [[0, 1, 0]] * 3 + [[0, 0, 1]] * 3
+    assert_array_equal(requests["transition_b_c"], switch)
+
+
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        (["--blend", "feminine", "robotic"], "--blend: the walks have no style "),
+        (["--seed-style", "jog"], "--seed-style: the walks have no style 'jog'"),
+        (["--transition", "active", "active"], "two different styles"),
+        (["--n-frames", "100"], "--n-frames must be at least 120"),
+    ],
+)
+def test_styles_checks_its_options_before_training(
+    data_home, tmp_path, capsys, monkeypatch, extra, message
+):
+    def no_training(*args, **kwargs):
+        raise AssertionError("trained before checking the options")
+
+    monkeypatch.setattr(_cli.FactoredCRBM, "fit", no_training)
+    assert main(styles_args(data_home, tmp_path / "out", *extra)) == 1
+    err = capsys.readouterr().err
+    assert message in err
+    if "no style" in message:
+        assert "their styles are active, elderly, exhausted" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_styles_without_matplotlib_writes_the_motion(
+    data_home, tmp_path, capsys, monkeypatch
+):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # import fails
+    argv = styles_args(data_home, tmp_path, "--n-sequences", "1", "--n-iter", "1")
+    assert main(argv) == 0
+    assert "no figures: sklearn_crbm.plotting needs matplotlib" in (
+        capsys.readouterr().out
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        f"{name}.bvh" for name in WRITTEN
+    )
+
+
+def test_styles_missing_data_says_how_to_fetch(tmp_path, capsys):
+    home = tmp_path / "nowhere"
+    assert main(["styles", "--data-home", str(home)]) == 1
+    err = capsys.readouterr().err
+    assert "The Bandai Namco walks are not in" in err
+    assert f"python -m sklearn_crbm fetch --dataset bandai --data-home {home}" in err
+
+
+def test_fetch_downloads_the_data_sets_asked_for(tmp_path, capsys, monkeypatch):
+    fetched = []
+    for name in ("fetch_cmu35", "fetch_mit_walk", "fetch_bandai_walks"):
+        monkeypatch.setattr(_cli, name, lambda home, name=name: fetched.append(name))
+    home = ["--data-home", str(tmp_path)]
+    assert main(["fetch", *home]) == 0
+    assert fetched == ["fetch_cmu35", "fetch_mit_walk"]
+    fetched.clear()
+    assert main(["fetch", "--dataset", "bandai", *home]) == 0
+    assert fetched == ["fetch_bandai_walks"]
+    fetched.clear()
+    assert main(["fetch", "--dataset", "bandai", "--dataset", "cmu35", *home]) == 0
+    assert fetched == ["fetch_bandai_walks", "fetch_cmu35"]

@@ -116,6 +116,12 @@ def test_docs_build(html_dir):
         "what_we_tried.html",
         "auto_examples/index.html",
         "generated/sklearn_crbm.ConditionalRBM.html",
+        "generated/sklearn_crbm.FactoredCRBM.html",
+        "generated/sklearn_crbm.LabelledCRBM.html",
+        "generated/sklearn_crbm.metrics.StyleJudge.html",
+        "generated/sklearn_crbm.datasets.load_bandai_walks.html",
+        "generated/sklearn_crbm.datasets.fetch_bandai_walks.html",
+        "generated/sklearn_crbm.plotting.plot_style_probabilities.html",
     ]:
         assert (html_dir / page).is_file(), page
     for page in [
@@ -129,6 +135,8 @@ def test_docs_build(html_dir):
         "model_selection",
         "saving",
         "scaling",
+        "labelled_motion",
+        "styles",
     ]:
         assert (html_dir / "user_guide" / f"{page}.html").is_file(), page
 
@@ -174,7 +182,10 @@ def test_root_figure_is_drawn(html_dir):
 
 
 @pytest.mark.parametrize("page", CODE_PAGES)
-def test_user_guide_code(page):
+def test_user_guide_code(page, data_home, monkeypatch):
+    # Pages on real data load it from the default data folder, as a user's
+    # script would once the data are fetched.
+    monkeypatch.setenv("SKLEARN_CRBM_DATA", str(data_home))
     output = io.StringIO()
     # Pages switch metadata routing on; config_context puts it back.
     with sklearn.config_context(), redirect_stdout(output):

@@ -33,7 +33,12 @@ REPO_ROOT = DOC_DIR.parent
 # re-exports names of its subpackages) is documented once, under the subpackage
 # that exports it; the top-level section then says where to find it.
 API_SECTIONS = [
-    ("sklearn_crbm", "Models", "The conditional RBM, its stack, and exceptions."),
+    (
+        "sklearn_crbm",
+        "Models",
+        "The conditional RBM, its stack, the models of labelled styles, and "
+        "exceptions.",
+    ),
     ("sklearn_crbm.impute", "Filling in missing channels", None),
     ("sklearn_crbm.preprocessing", "Motion preprocessing", None),
     ("sklearn_crbm.datasets", "Data sets, skeletons and mocap files", None),

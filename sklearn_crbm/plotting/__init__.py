@@ -12,9 +12,15 @@ matplotlib is imported only when a function is called.
   (paper Fig. 1).
 - :func:`plot_filled_channels`: filled-in against true channels, with a
   nearest-neighbour fill (paper Fig. 4).
+- :func:`plot_style_probabilities`: the probability of each style over the
+  frames of a sequence (a style judge's verdict on a transition).
 """
 
-from ._figures import plot_filled_channels, plot_hidden_activations
+from ._figures import (
+    plot_filled_channels,
+    plot_hidden_activations,
+    plot_style_probabilities,
+)
 from ._skeleton import (
     animate_motion,
     motion_to_html,
@@ -30,5 +36,6 @@ __all__ = [
     "plot_hidden_activations",
     "plot_motion_strip",
     "plot_skeleton",
+    "plot_style_probabilities",
     "save_animation",
 ]

@@ -1,11 +1,16 @@
-"""The paper's Fig. 1 (hidden activations) and Fig. 4 (filled-in channels)."""
+"""The paper's Fig. 1 (hidden activations) and Fig. 4 (filled-in channels),
+and the style of motion over time."""
 
 import numpy as np
 
 from ..utils._sequences import check_sequence_ids
 from ._base import check_matplotlib, get_axes
 
-__all__ = ["plot_filled_channels", "plot_hidden_activations"]
+__all__ = [
+    "plot_filled_channels",
+    "plot_hidden_activations",
+    "plot_style_probabilities",
+]
 
 
 def plot_hidden_activations(
@@ -48,20 +53,7 @@ def plot_hidden_activations(
     >>> ax.images[0].get_array().shape  # units by frames
     (8, 50)
     """
-    _check_dense(hidden, "hidden")
-    hidden = np.asarray(hidden, dtype=np.float64)
-    if hidden.ndim != 2 or 0 in hidden.shape:
-        raise ValueError(
-            "hidden must have shape (n_frames, n_components) with at least one "
-            f"frame and one unit, got shape {hidden.shape}."
-        )
-    if not np.isfinite(hidden).all():
-        raise ValueError("hidden contains NaN or infinity.")
-    if hidden.min() < 0 or hidden.max() > 1:
-        raise ValueError(
-            "hidden must hold probabilities in [0, 1] (the output of transform), "
-            f"got values in [{hidden.min():g}, {hidden.max():g}]."
-        )
+    hidden = _check_probabilities(hidden, "hidden", "n_components", "transform")
     n_frames, n_components = hidden.shape
     ax = get_axes(ax)
     scale = 1.0 if frame_rate is None else 1.0 / float(frame_rate)
@@ -84,6 +76,25 @@ def plot_hidden_activations(
     if colorbar:
         ax.figure.colorbar(image, ax=ax, label="p(h = 1 | data)")
     return ax
+
+
+def _check_probabilities(values, name, columns, method):
+    """``values`` as a float array of shape (n_frames, ``columns``) in [0, 1]."""
+    _check_dense(values, name)
+    values = np.asarray(values, dtype=np.float64)
+    if values.ndim != 2 or 0 in values.shape:
+        raise ValueError(
+            f"{name} must have shape (n_frames, {columns}) with at least one "
+            f"frame and one column, got shape {values.shape}."
+        )
+    if not np.isfinite(values).all():
+        raise ValueError(f"{name} contains NaN or infinity.")
+    if values.min() < 0 or values.max() > 1:
+        raise ValueError(
+            f"{name} must hold probabilities in [0, 1] (the output of {method}), "
+            f"got values in [{values.min():g}, {values.max():g}]."
+        )
+    return values
 
 
 def _check_dense(values, name):
@@ -214,3 +225,62 @@ def plot_filled_channels(
     axes[0].legend(loc="best", fontsize="small")
     axes[-1].set_xlabel("frame" if frame_rate is None else "time (s)")
     return axes
+
+
+def plot_style_probabilities(proba, *, classes=None, frame_rate=None, ax=None):
+    """Probability of each style over the frames of a sequence, one curve each.
+
+    Feed it the per-frame probabilities of
+    :meth:`StyleJudge.predict_proba <sklearn_crbm.metrics.StyleJudge.predict_proba>`
+    for one sequence, for example a generated transition from one style to
+    another, to see when the motion changes style.
+
+    Parameters
+    ----------
+    proba : array-like of shape (n_frames, n_classes)
+        Probability of every style at every frame, in [0, 1].
+    classes : array-like of shape (n_classes,), default=None
+        Names of the styles in the order of the columns (the judge's
+        ``classes_``), for the legend; default ``"style 0"``, ...
+    frame_rate : float, default=None
+        When given, the horizontal axis is in seconds instead of frames.
+    ax : matplotlib Axes, default=None
+        Where to draw; default a new figure.
+
+    Returns
+    -------
+    ax : matplotlib Axes
+        The axes, with one line per style, labelled with its name.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import numpy as np
+    >>> from sklearn_crbm.plotting import plot_style_probabilities
+    >>> fast = np.linspace(0, 1, 50)[:, None]  # from slow to fast
+    >>> ax = plot_style_probabilities(np.hstack([1 - fast, fast]),
+    ...                               classes=["slow", "fast"])
+    >>> [line.get_label() for line in ax.get_lines()]
+    ['slow', 'fast']
+    """
+    proba = _check_probabilities(proba, "proba", "n_classes", "predict_proba")
+    n_frames, n_classes = proba.shape
+    if classes is None:
+        classes = [f"style {k}" for k in range(n_classes)]
+    classes = np.asarray(classes, dtype=object)
+    if classes.shape != (n_classes,):
+        raise ValueError(
+            f"classes must name the {n_classes} styles of the columns of proba, "
+            f"got {classes.size} names."
+        )
+    ax = get_axes(ax)
+    scale = 1.0 if frame_rate is None else 1.0 / float(frame_rate)
+    time = np.arange(n_frames) * scale
+    for column, name in enumerate(classes):
+        ax.plot(time, proba[:, column], label=str(name))
+    ax.set_ylim(-0.02, 1.02)
+    ax.set_xlabel("frame" if frame_rate is None else "time (s)")
+    ax.set_ylabel("probability")
+    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small")
+    return ax

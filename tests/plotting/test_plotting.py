@@ -20,6 +20,7 @@ from sklearn_crbm.plotting import (  # noqa: E402
     plot_hidden_activations,
     plot_motion_strip,
     plot_skeleton,
+    plot_style_probabilities,
     save_animation,
 )
 
@@ -162,6 +163,30 @@ def test_filled_channels_have_true_model_and_nearest_curves():
         plot_filled_channels(true, true[:10])
     with pytest.raises(ValueError, match="named"):
         plot_filled_channels(true, true, features=["z"], feature_names=["a", "b", "c"])
+
+
+def test_style_probabilities_one_curve_per_style_over_time():
+    rng = np.random.default_rng(0)
+    proba = rng.dirichlet(np.ones(3), size=24)
+    ax = plot_style_probabilities(proba, classes=["a", "b", "c"], frame_rate=30.0)
+    lines = ax.get_lines()
+    assert [line.get_label() for line in lines] == ["a", "b", "c"]
+    for column, line in enumerate(lines):
+        assert_allclose(line.get_xdata(), np.arange(24) / 30.0)
+        assert_allclose(line.get_ydata(), proba[:, column])
+    assert ax.get_xlabel() == "time (s)" and ax.get_legend() is not None
+    unnamed = plot_style_probabilities(proba[:, :2])
+    assert [line.get_label() for line in unnamed.get_lines()] == [
+        "style 0",
+        "style 1",
+    ]
+    assert unnamed.get_xlabel() == "frame"
+    with pytest.raises(ValueError, match="shape \\(n_frames, n_classes\\)"):
+        plot_style_probabilities(proba[:, 0])
+    with pytest.raises(ValueError, match="in \\[0, 1\\]"):
+        plot_style_probabilities(proba * 2)
+    with pytest.raises(ValueError, match="the 3 styles"):
+        plot_style_probabilities(proba, classes=["a", "b"])
 
 
 def test_missing_matplotlib_names_the_plot_extra(monkeypatch, walker):

@@ -496,6 +496,21 @@ ENTRIES = [
         ),
     ),
     Entry(
+        "plotting.plot_style_probabilities",
+        lambda c: c.f["crbm"].transform(c.X),
+        lambda c, X: plotting.plot_style_probabilities(X),
+        fits=True,
+        overrides=(
+            ("NaN", ValueError, "proba contains NaN or infinity"),
+            ("inf", ValueError, "proba contains NaN or infinity"),
+            ("1-D", ValueError, r"proba must have shape \(n_frames, n_classes\)"),
+            ("3-D", ValueError, r"proba must have shape \(n_frames, n_classes\)"),
+            ("sparse", TypeError, "(?i)sparse"),
+            ("empty", ValueError, "with at least one frame and one column"),
+            ("no columns", ValueError, "with at least one frame and one column"),
+        ),
+    ),
+    Entry(
         "plotting.plot_filled_channels",
         lambda c: c.X,
         lambda c, X: plotting.plot_filled_channels(c.X, X),
