@@ -23,6 +23,7 @@ import subprocess
 import sys
 import time
 from contextlib import contextmanager
+from functools import partial
 from pathlib import Path
 
 import joblib
@@ -60,6 +61,12 @@ CELLS = ("walk/leg", "walk/upper", "jog/leg", "jog/upper")
 # The paper's joint encoding (rest-pose reference, Taylor's root roll), in
 # which the quality tables are measured.
 PAPER_ENCODING = dict(reference="rest", roll="taylor")
+REAL_TIME_FPS = 30.0  # the frame rate of the mocap, for "x real time"
+# The paper's §4.4 on its walk: the error of its CRBM and nearest neighbour.
+PAPER_ERRORS = {
+    "paper: CRBM": (8.78, 20.52),
+    "paper: nearest neighbour": (11.68, 22.20),
+}
 
 
 def parser(doc, seeds=(0, 1, 2, 3, 4)):
@@ -85,8 +92,6 @@ def speed_parser(doc, threads=(1, 2)):
 
 
 # -------------------------------------------------------- package, machine
-
-
 def package_description():
     """Where the package under test lives and which commit it is."""
     try:
@@ -135,8 +140,6 @@ def _cpu_name():
 
 
 # -------------------------------------------------------------------- data
-
-
 class Split:
     """One split of CMU subject 35: training trials and the erased test cases.
 
@@ -273,21 +276,27 @@ def load_training_data(name, data_home, dtype=np.float64):
     return np.asarray(X, dtype=dtype), np.asarray(bunch.sequence_ids), source
 
 
-# ------------------------------------------------------------- model cache
+def style_folds(styles, trials, n_folds=3):
+    """Trials per fold: the k-th trial of every style goes to fold ``k % n_folds``.
 
+    ``styles`` gives the style of every trial; ``trials`` are the trials to
+    split, in trial order.  Every fold holds walks and jogs.
+    """
+    folds = [[] for _ in range(n_folds)]
+    for style in np.unique(styles[trials]):
+        for k, trial in enumerate(t for t in trials if styles[t] == style):
+            folds[k % n_folds].append(int(trial))
+    return folds
+
+
+# ------------------------------------------------------------- model cache
 # A fit runs the models' modules and utils/, never these (nor the packages'
 # __init__ files, which only re-export): they are left out of the cache key,
 # so that changing them does not refit.
-_NOT_IN_A_FIT = {
-    "datasets",
-    "preprocessing",
-    "impute",
-    "metrics",
-    "model_selection",
-    "plotting",
-    "_cli.py",
-    "__main__.py",
-}
+_NOT_IN_A_FIT = set(
+    "datasets preprocessing impute metrics model_selection plotting _cli.py "
+    "__main__.py".split()
+)
 
 
 def model_code_digest():
@@ -334,33 +343,25 @@ def cached_fit(model, X, sequence_ids):
     path = CACHE / f"{type(model).__name__}_{key.hexdigest()[:24]}.joblib"
     if path.exists():
         return joblib.load(path)
-    start = time.perf_counter()
-    model.fit(X, sequence_ids=sequence_ids)
-    result = (model, time.perf_counter() - start)
+    result = (model, seconds(partial(model.fit, X, sequence_ids=sequence_ids)))
     path.parent.mkdir(parents=True, exist_ok=True)
     joblib.dump(result, path)
     return result
 
 
 # ----------------------------------------------------------------- fill-in
-
-
 def fitted_baselines(X, sequence_ids):
     """The simple imputers a user tries first, fitted on ``X``, by name."""
-    imputers = {
-        "NearestNeighborImputer": NearestNeighborImputer(),
-        "KNNImputer(1)": KNNImputer(n_neighbors=1),
-        "KNNImputer(5)": KNNImputer(n_neighbors=5),
-        "KNNImputer(10)": KNNImputer(n_neighbors=10),
-        "AR(3), full covariance": AutoregressiveImputer(order=3),
-        "AR(3), diagonal": AutoregressiveImputer(order=3, covariance_type="diag"),
+    ids = {"sequence_ids": sequence_ids}
+    diagonal = AutoregressiveImputer(order=3, covariance_type="diag")
+    return {
+        "NearestNeighborImputer": NearestNeighborImputer().fit(X),
+        "KNNImputer(1)": KNNImputer(n_neighbors=1).fit(X),
+        "KNNImputer(5)": KNNImputer(n_neighbors=5).fit(X),
+        "KNNImputer(10)": KNNImputer(n_neighbors=10).fit(X),
+        "AR(3), full covariance": AutoregressiveImputer(order=3).fit(X, **ids),
+        "AR(3), diagonal": diagonal.fit(X, **ids),
     }
-    for imputer in imputers.values():
-        if isinstance(imputer, AutoregressiveImputer):
-            imputer.fit(X, sequence_ids=sequence_ids)
-        else:
-            imputer.fit(X)
-    return imputers
 
 
 def crbm_imputer(X, sequence_ids, seed, model_params=None, imputer_params=None):
@@ -370,11 +371,15 @@ def crbm_imputer(X, sequence_ids, seed, model_params=None, imputer_params=None):
     ``ConditionalRBM`` and ``CRBMImputer``.
     """
     model = ConditionalRBM(random_state=seed, **(model_params or {}))
-    fitted, seconds = cached_fit(model, X, sequence_ids)
-    imputer = CRBMImputer(
-        FrozenEstimator(fitted), random_state=seed, **(imputer_params or {})
-    )
-    return imputer.fit(X, sequence_ids=sequence_ids), seconds
+    fitted, fit_seconds = cached_fit(model, X, sequence_ids)
+    imputer = frozen_imputer(fitted, X, sequence_ids, seed, **(imputer_params or {}))
+    return imputer, fit_seconds
+
+
+def frozen_imputer(model, X, sequence_ids, seed, *labels, **params):
+    """``CRBMImputer(**params)`` around the fitted ``model``, fitted on ``X``."""
+    imputer = CRBMImputer(FrozenEstimator(model), random_state=seed, **params)
+    return imputer.fit(X, *labels, sequence_ids=sequence_ids)
 
 
 def fill_errors(imputers, cases):
@@ -386,6 +391,14 @@ def fill_errors(imputers, cases):
     }
 
 
+def print_errors(errors, title, with_paper=False):
+    """Print ``{method: {cell: fill-in error}}``, after the paper's if asked."""
+    paper = PAPER_ERRORS.items() if with_paper else ()
+    rows = [dict(method=m, **dict(zip(CELLS, e, strict=False))) for m, e in paper]
+    rows += [dict(method=method, **cells) for method, cells in errors.items()]
+    print_table(rows, ["method", *((c, c, ".2f") for c in CELLS)], title=title)
+
+
 def log_ratio_row(name, log_ratios):
     """Mean log error ratio over seeds, its interval, and the cells won.
 
@@ -393,52 +406,43 @@ def log_ratio_row(name, log_ratios):
     training seed (and any number of cells per row).
     """
     mean, low, high = bootstrap_mean(log_ratios)
+    verdict = "better" if high < 0 else "worse" if low > 0 else "not significant"
+    won, of = int(np.sum(np.asarray(log_ratios) < 0)), int(np.size(log_ratios))
     return dict(
-        cells=name,
-        mean=mean,
-        low=low,
-        high=high,
-        verdict="better" if high < 0 else "worse" if low > 0 else "not significant",
-        won=int(np.sum(np.asarray(log_ratios) < 0)),
-        of=int(np.size(log_ratios)),
+        cells=name, mean=mean, low=low, high=high, verdict=verdict, won=won, of=of
     )
 
 
 def log_ratio_columns(reference="best baseline"):
     """The columns of :func:`log_ratio_row`'s table."""
     return [
-        ("cells", "cells", "s"),
+        "cells",
         ("mean", f"mean log(CRBM / {reference})", "+.3f"),
         ("low", "95% low", "+.3f"),
         ("high", "95% high", "+.3f"),
         ("verdict", f"than the {reference}", "s"),
         ("won", "cells won", "d"),
-        ("of", "of", "d"),
+        "of",
     ]
 
 
 # ------------------------------------------------------------- statistics
-
-
 def bootstrap_mean(values, n_resamples=10_000, level=0.95, seed=0):
     """Mean of ``values`` and its percentile bootstrap interval over seeds.
 
     ``values`` has one row per training seed (and any number of cells per
-    row); the rows are resampled with replacement.  Returns ``(mean, low,
-    high)``.
+    row); the rows are resampled with replacement, drawn from ``seed`` (an
+    int or a ``numpy.random.Generator``).  Returns ``(mean, low, high)``.
     """
-    values = np.asarray(values, dtype=float).reshape(len(values), -1)
-    rows = np.random.default_rng(seed).integers(
-        len(values), size=(n_resamples, len(values))
-    )
+    n = len(values)
+    values = np.asarray(values, dtype=float).reshape(n, -1)
+    rows = np.random.default_rng(seed).integers(n, size=(n_resamples, n))
     means = values[rows].mean(axis=(1, 2))
     low, high = np.quantile(means, [(1 - level) / 2, (1 + level) / 2])
     return float(values.mean()), float(low), float(high)
 
 
 # ------------------------------------------------------------------ timing
-
-
 @contextmanager
 def threadpool_limits(threads):
     """``threads`` BLAS threads, for the libraries and the package's loops."""
@@ -447,6 +451,21 @@ def threadpool_limits(threads):
         sklearn_crbm.config_context(blas_threads=threads),
     ):
         yield
+
+
+def seconds(func, repeats=1, sync=lambda: None):
+    """Best wall-clock seconds of ``repeats`` calls of ``func``.
+
+    ``sync`` waits for an accelerator before and after each call.
+    """
+    times = []
+    for _ in range(repeats):
+        sync()
+        start = time.perf_counter()
+        func()
+        sync()
+        times.append(time.perf_counter() - start)
+    return min(times)
 
 
 def time_both(func):
@@ -482,11 +501,8 @@ def cd_epoch_flops(n_frames, n_features, n_components, order, cd_steps=1):
     directed statistics.  Elementwise work is not counted.
     """
     d, h, k = n_features, n_components, order * n_features
-    return (
-        2
-        * n_frames
-        * (k * (d + h) + d * h + cd_steps * 2 * d * h + 2 * d * h + (d + h) * k)
-    )
+    per_frame = k * (d + h) + d * h + cd_steps * 2 * d * h + 2 * d * h + (d + h) * k
+    return 2 * n_frames * per_frame
 
 
 def frames_with_history(sequence_ids, order):
@@ -526,11 +542,8 @@ class EpochProducts:
 
         self.W, self.dynamic = random(h, d, order="F"), random(d + h, k, order="F")
         self.v, self.h, self.hist = random(n, d), random(n, h), random(n, k)
-        self.vs, self.hs, self.delta = (
-            random(2 * n, d),
-            random(2 * n, h),
-            random(n, d + h),
-        )
+        self.vs, self.hs = random(2 * n, d), random(2 * n, h)
+        self.delta = random(n, d + h)
         self.out_dyn, self.out_h = np.empty((n, d + h), dtype), np.empty((n, h), dtype)
         self.out_v = np.empty((n, d), dtype)
         self.out_w = np.empty((h, d), dtype, order="F")
@@ -546,23 +559,31 @@ class EpochProducts:
             np.matmul(self.delta[:n].T, self.hist[:n], out=self.out_d)
 
 
+def child_json(arguments, env=None):
+    """Run ``python *arguments`` in a fresh process; the JSON its last line prints."""
+    result = subprocess.run(
+        [sys.executable, *arguments], env=env, capture_output=True, text=True
+    )
+    if result.returncode != 0:
+        raise RuntimeError(result.stderr[-3000:])
+    return json.loads(result.stdout.strip().splitlines()[-1])
+
+
 # ------------------------------------------------------------------ output
-
-
 def print_table(rows, columns, title=None):
-    """Print ``rows`` (dicts) as a Markdown table; ``columns``: (key, header, format)."""
-    cells = [[header for _, header, _ in columns]]
-    for row in rows:
-        cells.append(
-            ["" if row.get(k) is None else format(row[k], f) for k, _, f in columns]
-        )
-    widths = [max(len(r[i]) for r in cells) for i in range(len(columns))]
+    """Print ``rows`` (dicts) as a Markdown table and return its text.
+
+    ``columns``: ``(key, header, format)``, or a key alone (its own header,
+    the value as it is).
+    """
+    columns = [(c, c, "") if isinstance(c, str) else c for c in columns]
+    header = [(name, str.ljust) for _, name, _ in columns]
+    body = [[_cell(row.get(key), spec) for key, _, spec in columns] for row in rows]
+    columns_text = zip(header, *body, strict=True)
+    widths = [max(len(text) for text, _ in column) for column in columns_text]
     lines = [title] if title else []
-    for i, r in enumerate(cells):
-        padded = (
-            c.ljust(w) if i == 0 or f == "s" else c.rjust(w)
-            for c, w, (_, _, f) in zip(r, widths, columns, strict=True)
-        )
+    for i, line in enumerate([header, *body]):
+        padded = (align(text, w) for (text, align), w in zip(line, widths, strict=True))
         lines.append("| " + " | ".join(padded) + " |")
         if i == 0:
             lines.append("|" + "|".join("-" * (w + 2) for w in widths) + "|")
@@ -571,16 +592,22 @@ def print_table(rows, columns, title=None):
     return text
 
 
-def write_json(name, payload, output=None):
-    """Write ``payload`` with the machine and the package under test."""
+def _cell(value, spec):
+    """The text of a table's cell and its alignment: text left, numbers right."""
+    if value is None:
+        return "", str.ljust
+    return format(value, spec), str.ljust if isinstance(value, str) else str.rjust
+
+
+def write_json(name, output, **payload):
+    """Write ``payload`` with the machine and the package under test.
+
+    To ``output``, by default ``benchmarks/results/<name>.json``.
+    """
     path = Path(output) if output else RESULTS / f"{name}.json"
     path.parent.mkdir(parents=True, exist_ok=True)
-    payload = {
-        "benchmark": name,
-        "package": package_description(),
-        "machine": machine(),
-        **payload,
-    }
+    package = package_description()
+    payload = dict(benchmark=name, package=package, machine=machine(), **payload)
     path.write_text(json.dumps(payload, indent=2, default=_jsonable))
     print(f"wrote {path}")
     return path

@@ -13,14 +13,16 @@ Run from the repository root (under a minute)::
     python benchmarks/bench_fillin.py --n-draws 1 10 --repeats 5
 """
 
-import time
+from functools import partial
 
 import numpy as np
 from _common import (
     PAPER,
+    REAL_TIME_FPS,
     Split,
     announce,
     print_table,
+    seconds,
     speed_parser,
     summary,
     threadpool_limits,
@@ -30,8 +32,6 @@ from _common import (
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm.impute import CRBMImputer
 from sklearn_crbm.model_selection import erasure_mask, paper_body_parts
-
-REAL_TIME_FPS = 30.0
 
 
 def main(argv=None):
@@ -56,15 +56,11 @@ def main(argv=None):
             imputer.fit(split.X_train.astype(dtype), sequence_ids=split.train_ids)
             for part, mask in masks.items():
                 X = np.where(mask, np.nan, split.X_test).astype(dtype)
-                times = []
+                ids = split.test_ids
+                fill = partial(imputer.transform, X, sequence_ids=ids)
                 with threadpool_limits(threads):
-                    imputer.transform(
-                        X[:20], sequence_ids=split.test_ids[:20]
-                    )  # warm up
-                    for _ in range(args.repeats):
-                        start = time.perf_counter()
-                        imputer.transform(X, sequence_ids=split.test_ids)
-                        times.append(time.perf_counter() - start)
+                    imputer.transform(X[:20], sequence_ids=ids[:20])  # warm up
+                    times = [seconds(fill) for _ in range(args.repeats)]
                 rows.append(
                     dict(
                         dtype=dtype,
@@ -82,21 +78,16 @@ def main(argv=None):
     table = print_table(
         rows,
         [
-            ("dtype", "dtype", "s"),
-            ("threads", "threads", "d"),
-            ("missing", "missing", "s"),
-            ("channels", "channels", "d"),
+            *("dtype", "threads", "missing", "channels"),
             ("n_draws", "draws", "d"),
-            ("frames", "frames", "d"),
+            "frames",
             ("seconds", "seconds (best)", ".3f"),
             ("frames_per_s", "frames/s", ",.0f"),
             ("x_real_time", "x real time", ",.1f"),
         ],
         title="\nFill-in with CRBMImputer's defaults, 62-200 order 3",
     )
-    write_json(
-        "bench_fillin", dict(args=vars(args), rows=rows, table=table), args.output
-    )
+    write_json("bench_fillin", args.output, args=vars(args), rows=rows, table=table)
 
 
 if __name__ == "__main__":

@@ -14,14 +14,16 @@ Run from the repository root (about a minute)::
     python benchmarks/bench_generate.py --n-frames 400 --repeats 7
 """
 
-import time
+from functools import partial
 
 import numpy as np
 from _common import (
     PAPER,
+    REAL_TIME_FPS,
     announce,
     load_training_data,
     print_table,
+    seconds,
     speed_parser,
     summary,
     threadpool_limits,
@@ -31,14 +33,13 @@ from scipy.special import expit
 
 from sklearn_crbm import ConditionalRBM
 
-REAL_TIME_FPS = 30.0
 
-
-def naive_generate(model, seed, n_samples, n_gibbs, rng):
+def naive_generate(model, seed, n_samples, n_gibbs, random_state):
     """The original generation scheme over many sequences, written plainly.
 
     ``seed`` has shape (n_sequences, order, n_features), oldest first.
     """
+    rng = np.random.default_rng(random_state)
     W, b, c = model.components_, model.intercept_hidden_, model.intercept_visible_
     A, B = model.autoregressive_, model.past_to_hidden_
     frames = list(np.moveaxis(seed, 1, 0))
@@ -51,12 +52,6 @@ def naive_generate(model, seed, n_samples, n_gibbs, rng):
             v = (rng.random(p.shape, dtype=W.dtype) < p).astype(W.dtype) @ W + c_hat
         frames.append(expit(v @ W.T + b_hat) @ W + c_hat)
     return np.stack(frames[seed.shape[1] :], axis=1)
-
-
-def seconds(func):
-    start = time.perf_counter()
-    func()
-    return time.perf_counter() - start
 
 
 def main(argv=None):
@@ -78,19 +73,9 @@ def main(argv=None):
                     len(model.seed_windows_), size=n_seq
                 )
                 seed = model.seed_windows_[picks]
-
-                def ours(seed=seed, model=model):
-                    model.sample(
-                        args.n_frames,
-                        history=seed,
-                        n_gibbs=args.n_gibbs,
-                        random_state=0,
-                    )
-
-                def naive(seed=seed, model=model):
-                    rng = np.random.default_rng(0)
-                    naive_generate(model, seed, args.n_frames, args.n_gibbs, rng)
-
+                steps = dict(n_gibbs=args.n_gibbs, random_state=0)
+                ours = partial(model.sample, args.n_frames, history=seed, **steps)
+                naive = partial(naive_generate, model, seed, args.n_frames, **steps)
                 with threadpool_limits(threads):
                     ours()  # warm up
                     pairs = [
@@ -119,8 +104,8 @@ def main(argv=None):
     table = print_table(
         rows,
         [
-            ("dtype", "dtype", "s"),
-            ("threads", "threads", "d"),
+            "dtype",
+            "threads",
             ("n_sequences", "sequences", "d"),
             ("frames", "new frames", "d"),
             ("seconds", "seconds (best)", ".3f"),
@@ -131,11 +116,8 @@ def main(argv=None):
         ],
         title="\nGeneration, 62-200 order 3",
     )
-    write_json(
-        "bench_generate",
-        dict(args=vars(args), data=source, rows=rows, table=table),
-        args.output,
-    )
+    payload = dict(args=vars(args), data=source, rows=rows, table=table)
+    write_json("bench_generate", args.output, **payload)
 
 
 if __name__ == "__main__":

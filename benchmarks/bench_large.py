@@ -4,27 +4,23 @@ Issue 18's configuration: a synthetic corpus of 10^6 frames x 100 channels
 (``_common.synthetic_motion``, 1000 sequences of 1000 frames, standardised),
 or a real corpus from ``--corpus FOLDER`` (every BVH file of the folder, or
 every AMC file with its ASF; preprocessed as the demo does), a CRBM with
-1000 hidden units and order 3, in float64 and float32.
-
-Rows, the best of ``--repeats`` timed calls (a run takes minutes, not hours):
+1000 hidden units and order 3, in float64 and float32.  Rows, the best of
+``--repeats`` timed calls (a run takes minutes, not hours):
 
 - ``train``: ``partial_fit`` (one epoch, CD-1) on the first ``--train-frames``
   frames of the corpus, in whole sequences, batch sizes 100 and 1000, with 1
-  BLAS thread and with all of them (``sklearn_crbm.config_context(
-  blas_threads=...)``): frames per second;
-- ``products``: the six matrix products of the same minibatches alone
-  (as in ``bench_train.py``), the ceiling of any implementation
-  that leaves them to BLAS; ``train / products`` is the overhead the issue
-  bounds at 1.3;
+  BLAS thread and with all of them: frames per second;
+- ``products``: the six matrix products of the same minibatches alone (as in
+  ``bench_train.py``); ``train / products`` is the overhead the issue bounds
+  at 1.3;
 - ``sample``: ``sample`` of ``--gen-frames`` frames for 1000 sequences
   together (30 Gibbs steps per frame): generated frames per second;
 - the same on a CUDA GPU through scikit-learn's array API (PyTorch tensors,
-  ``sklearn.set_config(array_api_dispatch=True)``) when PyTorch sees one;
-  the table says so when none is there.
+  ``array_api_dispatch=True``) when PyTorch sees one; the table says so when
+  none is there.
 
-Peak memory: the largest traced allocation (``tracemalloc``; numpy and the
-package report theirs) above what was held before each row, and for GPU rows
-``torch.cuda.max_memory_allocated``.
+Peak memory: the largest traced allocation (``tracemalloc``) above what was
+held before each row, and for GPU rows ``torch.cuda.max_memory_allocated``.
 
 Run from the repository root (``SCIPY_ARRAY_API=1`` is set here for the GPU
 rows)::
@@ -32,8 +28,6 @@ rows)::
     python benchmarks/bench_large.py                       # about 10 minutes
     python benchmarks/bench_large.py --frames 100000 --train-frames 10000
     python benchmarks/bench_large.py --corpus ../shared/data/cmu_subject35
-
-Prints a table and writes ``benchmarks/results/bench_large.json``.
 """
 
 import argparse
@@ -41,9 +35,8 @@ import os
 
 os.environ.setdefault("SCIPY_ARRAY_API", "1")  # before SciPy is imported
 
-import math  # noqa: E402
-import time  # noqa: E402
 import tracemalloc  # noqa: E402
+from functools import partial  # noqa: E402
 
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
@@ -55,6 +48,7 @@ from _common import (  # noqa: E402
     frames_with_history,
     gemm_peak,
     print_table,
+    seconds,
     synthetic_motion,
     threadpool_limits,
     write_json,
@@ -90,14 +84,19 @@ def first_sequences(ids, n_frames):
     return slice(0, int(stops[min(np.searchsorted(stops, n_frames), len(stops) - 1)]))
 
 
-def model(args, batch_size, random_state=0):
+def model(args, batch_size):
     return ConditionalRBM(
         args.components,
         order=args.order,
         batch_size=batch_size,
         n_iter=1,
-        random_state=random_state,
+        random_state=0,
     )
+
+
+def started(args, batch_size, X, sequence_ids):
+    """A new model after its first epoch, on ``X``."""
+    return model(args, batch_size).partial_fit(X, sequence_ids=sequence_ids)
 
 
 def peak_mb(func):
@@ -113,113 +112,54 @@ def peak_mb(func):
         tracemalloc.stop()
 
 
-def timed(func, repeats=1, sync=lambda: None):
-    """Best wall-clock seconds of ``repeats`` calls of ``func``."""
-    times = []
-    for _ in range(repeats):
-        sync()
-        start = time.perf_counter()
-        func()
-        sync()
-        times.append(time.perf_counter() - start)
-    return min(times)
+def rate_row(keys, task, frames, elapsed, flops=None, **measured):
+    """A row of the table: ``frames`` (of ``flops``) processed in ``elapsed`` s."""
+    rate = dict(frames=frames, seconds=elapsed, frames_per_s=frames / elapsed)
+    if flops is not None:
+        rate["gflops"] = flops / elapsed / 1e9
+    return dict(keys, task=task, **rate, **measured)
 
 
 def cpu_rows(args, X, ids, dtype, threads):
     part = first_sequences(ids, args.train_frames)
     X_train, ids_train = X[part], ids[part]
+    valid = frames_with_history(ids_train, args.order)
+    flops = cd_epoch_flops(len(valid), X.shape[1], args.components, args.order)
     # memory: a short run of the same call (its buffers do not grow with X)
     short = first_sequences(ids, 5000)
+    keys = dict(dtype=np.dtype(dtype).name, threads=threads)
     with threadpool_limits(threads):  # how much the threads give on a large product
-        gemm = gemm_peak(dtype, 2000)[0]
-    rows = [
-        dict(
-            dtype=np.dtype(dtype).name,
-            threads=threads,
-            device="cpu",
-            task="gemm 2000",
-            gflops=gemm,
-        )
-    ]
-    trained = None
+        rows = [dict(keys, device="cpu", task="gemm 2000", gflops=gemm_peak(dtype)[0])]
     for batch_size in args.batch_sizes:
-        valid = frames_with_history(ids_train, args.order)
         sizes = epoch_batch_sizes(len(valid), batch_size)
         products = EpochProducts(
             X.shape[1], args.components, args.order, batch_size, dtype
         )
+        start = partial(started, args, batch_size, X[short], ids[short])
         with threadpool_limits(threads):
-            # warmed up: started on a few frames, then timed on many
-            estimator = model(args, batch_size)
-            estimator.partial_fit(X[short], sequence_ids=ids[short])
+            estimator = start()  # warmed up: started on a few frames, timed on many
             products.epoch(sizes[:5])
-            seconds = products_seconds = math.inf
-            for _ in range(args.repeats):  # interleaved: load changes hit both
-                seconds = min(
-                    seconds,
-                    timed(
-                        lambda e=estimator: e.partial_fit(
-                            X_train, sequence_ids=ids_train
-                        )
-                    ),
-                )
-                products_seconds = min(
-                    products_seconds, timed(lambda p=products, s=sizes: p.epoch(s))
-                )
-            peak = peak_mb(
-                lambda b=batch_size: model(args, b).partial_fit(
-                    X[short], sequence_ids=ids[short]
-                )
-            )
-        common = dict(dtype=np.dtype(dtype).name, threads=threads, batch=batch_size)
-        flops = cd_epoch_flops(len(valid), X.shape[1], args.components, args.order)
+            train = partial(estimator.partial_fit, X_train, sequence_ids=ids_train)
+            epoch = partial(products.epoch, sizes)
+            # interleaved: load changes hit both
+            pairs = [(seconds(train), seconds(epoch)) for _ in range(args.repeats)]
+            train_s, products_s = (min(t) for t in zip(*pairs, strict=True))
+            peak = peak_mb(start)
+        batch, n = dict(keys, batch=batch_size, device="cpu"), len(valid)
+        over = train_s / products_s
         rows.append(
-            dict(
-                common,
-                device="cpu",
-                task="train",
-                frames=len(valid),
-                seconds=seconds,
-                frames_per_s=len(valid) / seconds,
-                gflops=flops / seconds / 1e9,
-                peak_mb=peak,
-                over_products=seconds / products_seconds,
+            rate_row(
+                batch, "train", n, train_s, flops, peak_mb=peak, over_products=over
             )
         )
-        rows.append(
-            dict(
-                common,
-                device="cpu",
-                task="products",
-                frames=len(valid),
-                seconds=products_seconds,
-                frames_per_s=len(valid) / products_seconds,
-                gflops=flops / products_seconds / 1e9,
-            )
-        )
-        trained = estimator
+        rows.append(rate_row(batch, "products", n, products_s, flops))
+    generate = partial(estimator.sample, n_sequences=args.sequences, random_state=0)
     with threadpool_limits(threads):
-        seconds = timed(
-            lambda: trained.sample(
-                args.gen_frames, n_sequences=args.sequences, random_state=0
-            ),
-            args.repeats,
-        )
-        peak = peak_mb(
-            lambda: trained.sample(1, n_sequences=args.sequences, random_state=0)
-        )
-    rows.append(
-        dict(
-            dtype=np.dtype(dtype).name,
-            threads=threads,
-            device="cpu",
-            task="sample",
-            frames=args.gen_frames * args.sequences,
-            seconds=seconds,
-            frames_per_s=args.gen_frames * args.sequences / seconds,
-            peak_mb=peak,
-        )
-    )
+        elapsed = seconds(partial(generate, args.gen_frames), args.repeats)
+        peak = peak_mb(partial(generate, 1))
+    frames = args.gen_frames * args.sequences
+    cpu = dict(keys, device="cpu")
+    rows.append(rate_row(cpu, "sample", frames, elapsed, peak_mb=peak))
     return rows
 
 
@@ -235,118 +175,67 @@ def cuda_device():
 
 
 def gpu_rows(args, torch, X, ids, dtype):
-    rows = []
-    sync = torch.cuda.synchronize
+    cuda = torch.cuda
     part = first_sequences(ids, args.gpu_train_frames)
     ids_train = ids[part]
     valid = frames_with_history(ids_train, args.order)
+    keys = dict(dtype=np.dtype(dtype).name, threads=None)
+    rows = []
     with sklearn.config_context(array_api_dispatch=True):
         X_gpu = torch.asarray(X[part], device="cuda")
-        model(args, 100).partial_fit(X_gpu[:5000], sequence_ids=ids_train[:5000])
-        trained = None
+        started(args, 100, X_gpu[:5000], ids_train[:5000])  # warm up
         for batch_size in args.batch_sizes:
-            torch.cuda.reset_peak_memory_stats()
+            cuda.reset_peak_memory_stats()
             estimator = model(args, batch_size)
-            seconds = timed(
-                lambda e=estimator: e.partial_fit(X_gpu, sequence_ids=ids_train),
-                args.repeats,
-                sync,
-            )
-            rows.append(
-                dict(
-                    dtype=np.dtype(dtype).name,
-                    threads=None,
-                    batch=batch_size,
-                    device=torch.cuda.get_device_name(),
-                    task="train",
-                    frames=len(valid),
-                    seconds=seconds,
-                    frames_per_s=len(valid) / seconds,
-                    peak_mb=torch.cuda.max_memory_allocated() / 1e6,
-                )
-            )
-            trained = estimator
-        torch.cuda.reset_peak_memory_stats()
-        seconds = timed(
-            lambda: trained.sample(
-                args.gen_frames, n_sequences=args.sequences, random_state=0
-            ),
-            args.repeats,
-            sync,
+            train = partial(estimator.partial_fit, X_gpu, sequence_ids=ids_train)
+            elapsed = seconds(train, args.repeats, cuda.synchronize)
+            batch = dict(keys, batch=batch_size, device=cuda.get_device_name())
+            peak = cuda.max_memory_allocated() / 1e6
+            rows.append(rate_row(batch, "train", len(valid), elapsed, peak_mb=peak))
+        cuda.reset_peak_memory_stats()
+        generate = partial(estimator.sample, n_sequences=args.sequences, random_state=0)
+        elapsed = seconds(
+            partial(generate, args.gen_frames), args.repeats, cuda.synchronize
         )
-    rows.append(
-        dict(
-            dtype=np.dtype(dtype).name,
-            threads=None,
-            device=torch.cuda.get_device_name(),
-            task="sample",
-            frames=args.gen_frames * args.sequences,
-            seconds=seconds,
-            frames_per_s=args.gen_frames * args.sequences / seconds,
-            peak_mb=torch.cuda.max_memory_allocated() / 1e6,
-        )
-    )
+    frames, peak = args.gen_frames * args.sequences, cuda.max_memory_allocated() / 1e6
+    device = dict(keys, device=cuda.get_device_name())
+    rows.append(rate_row(device, "sample", frames, elapsed, peak_mb=peak))
     return rows
 
 
 def speedups(rows):
     """GPU frames/s over the best CPU row of the same task, dtype and batch."""
-    result = []
-    for gpu in (r for r in rows if r["device"] != "cpu"):
-        cpu = [
-            r["frames_per_s"]
-            for r in rows
-            if r["device"] == "cpu"
-            and r["task"] == gpu["task"]
-            and r["dtype"] == gpu["dtype"]
-            and r.get("batch") == gpu.get("batch")
-        ]
-        if cpu:
-            result.append(
-                dict(
-                    task=gpu["task"],
-                    dtype=gpu["dtype"],
-                    batch=gpu.get("batch"),
-                    speedup=gpu["frames_per_s"] / max(cpu),
-                )
-            )
-    return result
+
+    def kind(row):
+        return dict(task=row["task"], dtype=row["dtype"], batch=row.get("batch"))
+
+    cpu = [row for row in rows if row["device"] == "cpu" and "frames_per_s" in row]
+    return [
+        dict(kind(gpu), speedup=gpu["frames_per_s"] / max(fast))
+        for gpu in rows
+        if gpu["device"] != "cpu"
+        and (fast := [r["frames_per_s"] for r in cpu if kind(r) == kind(gpu)])
+    ]
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--frames", type=int, default=1_000_000)
-    parser.add_argument("--features", type=int, default=100)
-    parser.add_argument("--corpus", default=None, help="folder of BVH or AMC files")
-    parser.add_argument("--components", type=int, default=1000)
-    parser.add_argument("--order", type=int, default=3)
-    parser.add_argument("--batch-sizes", type=int, nargs="+", default=[100, 1000])
-    parser.add_argument(
-        "--train-frames",
-        type=int,
-        default=20_000,
-        help="CPU training is timed on the first sequences holding this many frames",
-    )
-    parser.add_argument(
-        "--gpu-train-frames",
-        type=int,
-        default=1_000_000,
-        help="GPU training is timed on this many frames (an epoch of the corpus)",
-    )
-    parser.add_argument("--sequences", type=int, default=1000)
-    parser.add_argument("--gen-frames", type=int, default=3)
-    parser.add_argument(
-        "--threads",
-        type=int,
-        nargs="+",
-        default=sorted({1, os.cpu_count() or 1}),
-        help="BLAS thread counts of the CPU rows (default: 1 and all cores)",
-    )
-    parser.add_argument("--dtypes", nargs="+", default=["float64", "float32"])
-    parser.add_argument(
-        "--repeats", type=int, default=3, help="timed calls per row (best is kept)"
-    )
-    parser.add_argument("--output", default=None)
+    add = parser.add_argument
+    add("--frames", type=int, default=1_000_000)
+    add("--features", type=int, default=100)
+    add("--corpus", default=None, help="folder of BVH or AMC files")
+    add("--components", type=int, default=1000)
+    add("--order", type=int, default=3)
+    add("--batch-sizes", type=int, nargs="+", default=[100, 1000])
+    add("--train-frames", type=int, default=20_000, help="CPU training frames")
+    add("--gpu-train-frames", type=int, default=1_000_000, help="GPU training frames")
+    add("--sequences", type=int, default=1000)
+    add("--gen-frames", type=int, default=3)
+    all_cores = sorted({1, os.cpu_count() or 1})
+    add("--threads", type=int, nargs="+", default=all_cores, help="of the CPU rows")
+    add("--dtypes", nargs="+", default=["float64", "float32"])
+    add("--repeats", type=int, default=3, help="timed calls per row (best is kept)")
+    add("--output", default=None)
     args = parser.parse_args(argv)
     announce()
     torch, no_gpu = cuda_device()
@@ -359,12 +248,7 @@ def main(argv=None):
         if torch is not None:
             rows.extend(gpu_rows(args, torch, X, ids, dtype))
     columns = [
-        ("task", "task", "s"),
-        ("device", "device", "s"),
-        ("dtype", "dtype", "s"),
-        ("threads", "threads", "d"),
-        ("batch", "batch", "d"),
-        ("frames", "frames", "d"),
+        *("task", "device", "dtype", "threads", "batch", "frames"),
         ("seconds", "s", ".2f"),
         ("frames_per_s", "frames/s", ",.0f"),
         ("gflops", "GFLOP/s", ".1f"),
@@ -381,25 +265,11 @@ def main(argv=None):
         print(f"No GPU rows: {no_gpu}.")
     else:
         print_table(
-            gains,
-            [
-                ("task", "task", "s"),
-                ("dtype", "dtype", "s"),
-                ("batch", "batch", "d"),
-                ("speedup", "GPU / best CPU", ".1f"),
-            ],
+            gains, ["task", "dtype", "batch", ("speedup", "GPU / best CPU", ".1f")]
         )
-    write_json(
-        "bench_large",
-        {
-            "config": vars(args),
-            "corpus": corpora,
-            "gpu": no_gpu or torch.cuda.get_device_name(),
-            "rows": rows,
-            "gpu_over_cpu": gains,
-        },
-        args.output,
-    )
+    gpu = no_gpu or torch.cuda.get_device_name()
+    payload = dict(config=vars(args), corpus=corpora, gpu=gpu, rows=rows)
+    write_json("bench_large", args.output, **payload, gpu_over_cpu=gains)
 
 
 if __name__ == "__main__":

@@ -19,16 +19,11 @@ Run from the repository root::
 
     python benchmarks/bench_memory.py                     # about a minute
     python benchmarks/bench_memory.py --orders 1 3 6 12 24
-
-Prints a table and writes ``benchmarks/results/bench_memory.json``.
 """
 
-import json
-import subprocess
-import sys
 from pathlib import Path
 
-from _common import announce, parser, print_table, write_json
+from _common import announce, child_json, parser, print_table, write_json
 
 BUDGET_MB = 150.0
 
@@ -84,10 +79,7 @@ def main(argv=None):
         code = CHILD.format(
             bench_dir=bench_dir, n=args.frames, order=order, dtype=args.dtype
         )
-        result = subprocess.run(
-            [sys.executable, "-c", code], capture_output=True, text=True, check=True
-        )
-        row = json.loads(result.stdout.strip().splitlines()[-1])
+        row = child_json(["-c", code])
         row.update(order=order, frames=args.frames, dtype=args.dtype)
         added = max(row["traced_mb"], row["peak_rss_added_mb"])
         row["within_budget"] = "yes" if added <= BUDGET_MB else "NO"
@@ -95,19 +87,16 @@ def main(argv=None):
         print(f"  order {order}: {row['traced_mb']:.1f} MB traced", flush=True)
     columns = [
         ("frames", "frames", ",d"),
-        ("dtype", "dtype", "s"),
-        ("order", "order", "d"),
+        "dtype",
+        "order",
         ("data_mb", "data MB", ".0f"),
         ("traced_mb", "fit adds, traced MB", ".1f"),
         ("peak_rss_added_mb", "fit adds, peak RSS MB", ".1f"),
         ("within_budget", f"<= {BUDGET_MB:.0f} MB", "s"),
     ]
-    table = print_table(
-        rows, columns, title="Memory of fit, 62 dims, 200 hidden, 1 epoch"
-    )
-    write_json(
-        "bench_memory", {"args": vars(args), "rows": rows, "table": table}, args.output
-    )
+    title = "Memory of fit, 62 dims, 200 hidden, 1 epoch"
+    table = print_table(rows, columns, title=title)
+    write_json("bench_memory", args.output, args=vars(args), rows=rows, table=table)
 
 
 if __name__ == "__main__":

@@ -87,16 +87,14 @@ def main(argv=None):
                     epochs, repeats = (1, 1) if big else (args.epochs, args.repeats)
                     row = epoch_cost(X, ids, n_components, q, epochs, repeats, peak)
                     rows.append(dict(sweep=sweep, value=value, dtype=dtype, **row))
-                    print(
-                        f"  {sweep}={value}: {row['ms_per_epoch']:.1f} ms/epoch",
-                        flush=True,
-                    )
+                    ms = row["ms_per_epoch"]
+                    print(f"  {sweep}={value}: {ms:.1f} ms/epoch", flush=True)
     table = print_table(
         rows,
         [
-            ("sweep", "sweep", "s"),
+            "sweep",
             ("value", "value", ",d"),
-            ("dtype", "dtype", "s"),
+            "dtype",
             ("n_train_frames", "train frames", ",d"),
             ("ms_per_epoch", "ms/epoch", ",.1f"),
             ("cpu_ms_per_epoch", "CPU ms/epoch", ",.1f"),
@@ -106,9 +104,7 @@ def main(argv=None):
         ],
         title="\nTraining cost per epoch (62 dims; 200 hidden, order 3 unless swept)",
     )
-    write_json(
-        "bench_scaling", dict(args=vars(args), rows=rows, table=table), args.output
-    )
+    write_json("bench_scaling", args.output, args=vars(args), rows=rows, table=table)
 
 
 if __name__ == "__main__":

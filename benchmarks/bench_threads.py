@@ -34,18 +34,22 @@ import statistics
 import subprocess
 import sys
 import time
+from functools import partial
 
-from _common import announce, load_training_data, print_table, write_json
+from _common import (
+    announce,
+    child_json,
+    load_training_data,
+    print_table,
+    seconds,
+    write_json,
+)
 from _common import parser as make_parser
 
 THREAD_VARIABLES = (
-    "OPENBLAS_NUM_THREADS",
-    "OMP_NUM_THREADS",
-    "MKL_NUM_THREADS",
-    "BLIS_NUM_THREADS",
-    "VECLIB_MAXIMUM_THREADS",
-    "NUMEXPR_NUM_THREADS",
-)
+    "OPENBLAS_NUM_THREADS OMP_NUM_THREADS MKL_NUM_THREADS BLIS_NUM_THREADS "
+    "VECLIB_MAXIMUM_THREADS NUMEXPR_NUM_THREADS"
+).split()
 TARGET = 1.2
 
 
@@ -69,26 +73,13 @@ def train_in_child(data_home, epochs, blas_threads):
         sklearn_crbm.set_config(blas_threads=blas_threads)
     Z, ids, _ = load_training_data("cmu35", data_home)
     ConditionalRBM(n_iter=1, random_state=0).fit(Z, sequence_ids=ids)  # warm up
-    start = time.perf_counter()
-    ConditionalRBM(n_iter=epochs, random_state=0).fit(Z, sequence_ids=ids)
-    seconds = time.perf_counter() - start
-    print(json.dumps({"ms_per_epoch": 1000 * seconds / epochs}))
-
-
-def run_child(env, blas_threads, data_home, epochs):
-    command = [sys.executable, __file__, "--child", "--data-home", str(data_home)]
-    command += ["--epochs", str(epochs)]
-    if blas_threads is not None:
-        command += ["--child-blas-threads", str(blas_threads)]
-    result = subprocess.run(
-        command, env=env, capture_output=True, text=True, check=False
-    )
-    if result.returncode != 0:
-        raise RuntimeError(result.stderr[-3000:])
-    return json.loads(result.stdout.strip().splitlines()[-1])["ms_per_epoch"]
+    model = ConditionalRBM(n_iter=epochs, random_state=0)
+    elapsed = seconds(partial(model.fit, Z, sequence_ids=ids))
+    print(json.dumps({"ms_per_epoch": 1000 * elapsed / epochs}))
 
 
 def measure(load, args):
+    """Per environment: the median and every run's ms per epoch."""
     busy = None
     if load == "loaded":
         busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
@@ -98,7 +89,11 @@ def measure(load, args):
         for _ in range(args.repeats):
             for name, (env, blas_threads) in environments().items():
                 epochs = args.old_epochs if name == "all threads" else args.epochs
-                times[name].append(run_child(env, blas_threads, args.data_home, epochs))
+                child = [__file__, "--child", "--data-home", str(args.data_home)]
+                child += ["--epochs", str(epochs)]
+                if blas_threads is not None:
+                    child += ["--child-blas-threads", str(blas_threads)]
+                times[name].append(child_json(child, env)["ms_per_epoch"])
     finally:
         if busy is not None:
             busy.terminate()
@@ -121,18 +116,13 @@ def main():
         return
 
     announce()
-    rows, raw = [], {}
+    rows, raw, ratios = [], {}, {}
     for load in ("quiet", "loaded"):
         medians, raw[load] = measure(load, args)
+        ratios[load] = medians["default"] / medians["one thread"]
         for name, ms in medians.items():
-            rows.append(
-                {
-                    "load": load,
-                    "environment": name,
-                    "ms": ms,
-                    "ratio": ms / medians["one thread"],
-                }
-            )
+            ratio = ms / medians["one thread"]
+            rows.append(dict(load=load, environment=name, ms=ms, ratio=ratio))
     print_table(
         rows,
         [
@@ -145,19 +135,13 @@ def main():
         f"{args.repeats} runs ({args.epochs} epochs; 'all threads': "
         f"{args.old_epochs})",
     )
-    ratios = {
-        row["load"]: row["ratio"] for row in rows if row["environment"] == "default"
-    }
     met = all(r <= TARGET for r in ratios.values())
     print(
         f"default / one thread: quiet {ratios['quiet']:.2f}, loaded "
         f"{ratios['loaded']:.2f} (target <= {TARGET}): {'met' if met else 'NOT met'}"
     )
-    write_json(
-        "bench_threads",
-        {"rows": rows, "runs_ms_per_epoch": raw, "target": TARGET, "met": met},
-        args.output,
-    )
+    payload = dict(rows=rows, runs_ms_per_epoch=raw, target=TARGET, met=met)
+    write_json("bench_threads", args.output, **payload)
 
 
 if __name__ == "__main__":

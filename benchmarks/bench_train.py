@@ -22,6 +22,8 @@ Run from the repository root (a few minutes)::
     python benchmarks/bench_train.py --epochs 50 --repeats 9 --threads 1
 """
 
+from functools import partial
+
 import numpy as np
 from _common import (
     PAPER,
@@ -93,23 +95,15 @@ class NaiveCD:
 
 
 def run_config(name, X, ids, dtype, threads, args):
-    X = X.astype(dtype)
-    d, h, order, bs = (
-        X.shape[1],
-        PAPER["n_components"],
-        PAPER["order"],
-        PAPER["batch_size"],
-    )
+    X, d = X.astype(dtype), X.shape[1]
+    h, order, bs = PAPER["n_components"], PAPER["order"], PAPER["batch_size"]
     frames = frames_with_history(ids, order)
     flops = cd_epoch_flops(len(frames), d, h, order)
     sizes = epoch_batch_sizes(len(frames), bs)
     products = EpochProducts(d, h, order, bs, dtype)
     naive = NaiveCD(d, h, order, dtype)
 
-    def model(n_iter):
-        return ConditionalRBM(
-            h, order=order, batch_size=bs, n_iter=n_iter, random_state=0
-        )
+    model = partial(ConditionalRBM, h, order=order, batch_size=bs, random_state=0)
 
     def naive_fit():
         rng = np.random.default_rng(0)
@@ -117,7 +111,7 @@ def run_config(name, X, ids, dtype, threads, args):
             naive.epoch(X, frames, bs, rng, 0.9 if epoch >= 5 else 0.0)
 
     timed = {
-        "sklearn_crbm": lambda: model(args.epochs).fit(X, sequence_ids=ids),
+        "sklearn_crbm": lambda: model(n_iter=args.epochs).fit(X, sequence_ids=ids),
         "naive numpy": naive_fit,
         "matrix products alone": lambda: [
             products.epoch(sizes) for _ in range(args.epochs)
@@ -125,7 +119,7 @@ def run_config(name, X, ids, dtype, threads, args):
     }
     times, peaks = {k: [] for k in timed}, []
     with threadpool_limits(threads):
-        model(1).fit(X, sequence_ids=ids)  # warm up
+        model(n_iter=1).fit(X, sequence_ids=ids)  # warm up
         for _ in range(args.repeats):  # interleaved: load changes hit all alike
             peaks.append(gemm_peak(dtype))
             for key, func in timed.items():
@@ -134,6 +128,7 @@ def run_config(name, X, ids, dtype, threads, args):
     rows = []
     for impl, ts in times.items():
         wall, cpu = (np.array(t) / args.epochs for t in zip(*ts, strict=True))
+        cpu_percent = 100 * flops / cpu.min() / 1e9 / peak_cpu
         rows.append(
             dict(
                 config=name,
@@ -146,18 +141,14 @@ def run_config(name, X, ids, dtype, threads, args):
                 frames_per_s=len(frames) / wall.min(),
                 gflops=flops / wall.min() / 1e9,
                 percent_of_peak=100 * flops / wall.min() / 1e9 / peak_wall,
-                cpu_percent_of_peak=100 * flops / cpu.min() / 1e9 / peak_cpu
-                if threads == 1
-                else None,
+                cpu_percent_of_peak=cpu_percent if threads == 1 else None,
                 times={"wall": summary(list(wall)), "cpu": summary(list(cpu))},
             )
         )
-    ours, naive_row, products_row = rows
+    ours, naive_row, alone = rows
     ours["x_naive"] = naive_row["ms_per_epoch"] / ours["ms_per_epoch"]
-    ours["vs_products"] = ours["ms_per_epoch"] / products_row["ms_per_epoch"]
-    ours["cpu_vs_products"] = (
-        ours["cpu_ms_per_epoch"] / products_row["cpu_ms_per_epoch"]
-    )
+    ours["vs_products"] = ours["ms_per_epoch"] / alone["ms_per_epoch"]
+    ours["cpu_vs_products"] = ours["cpu_ms_per_epoch"] / alone["cpu_ms_per_epoch"]
     return rows
 
 
@@ -187,8 +178,8 @@ def main(argv=None):
         [
             ("config", "configuration", "s"),
             ("impl", "implementation", "s"),
-            ("dtype", "dtype", "s"),
-            ("threads", "threads", "d"),
+            "dtype",
+            "threads",
             ("ms_per_epoch", "ms/epoch (best)", ".2f"),
             ("ms_per_epoch_median", "median", ".2f"),
             ("cpu_ms_per_epoch", "CPU ms/epoch", ".2f"),
@@ -203,11 +194,8 @@ def main(argv=None):
         ],
         title="\nTraining, CD-1, batch 100",
     )
-    write_json(
-        "bench_train",
-        dict(args=vars(args), data=sources, rows=rows, table=table),
-        args.output,
-    )
+    payload = dict(args=vars(args), data=sources, rows=rows, table=table)
+    write_json("bench_train", args.output, **payload)
 
 
 if __name__ == "__main__":

@@ -43,12 +43,10 @@ from _common import (
     log_ratio_columns,
     log_ratio_row,
     parser,
+    print_errors,
     print_table,
     write_json,
 )
-
-# The paper's §4.4 on its walk: its CRBM and its nearest neighbour.
-PAPER = {"paper: CRBM": (8.78, 20.52), "paper: nearest neighbour": (11.68, 22.20)}
 
 
 def measure(split, seeds, model_params, imputer_params):
@@ -65,18 +63,10 @@ def measure(split, seeds, model_params, imputer_params):
     return base, crbm
 
 
-def error_rows(split, base, crbm):
+def errors_by_method(base, crbm):
     best = {c: min(row[c] for row in base.values()) for c in CELLS}
-    rows = [dict(method=name, **row) for name, row in base.items()]
-    if split == "paper":
-        rows[:0] = [
-            dict(method=name, **dict(zip(CELLS[:2], errors, strict=True)))
-            for name, errors in PAPER.items()
-        ]
-    rows.append(dict(method="best baseline", **best))
-    for seed, row in crbm.items():
-        rows.append(dict(method=f"CRBM, seed {seed}", **row))
-    return rows
+    seeds = {f"CRBM, seed {seed}": row for seed, row in crbm.items()}
+    return {**base, "best baseline": best, **seeds}
 
 
 def log_ratio_rows(results):
@@ -105,11 +95,11 @@ def main(argv=None):
     for name in args.splits:
         split = Split(args.data_home, name)
         results[name] = measure(split, args.seeds, model_params, imputer_params)
-        print_table(
-            error_rows(name, *results[name]),
-            [("method", "method", "s"), *((c, c, ".2f") for c in CELLS)],
-            title=f"\nSplit {name} ({', '.join(split.trials)} held out): the "
-            "paper's error, lower is better",
+        print_errors(
+            errors_by_method(*results[name]),
+            f"\nSplit {name} ({', '.join(split.trials)} held out): the paper's "
+            "error, lower is better",
+            with_paper=name == "paper",
         )
     ratios = log_ratio_rows(results)
     table = print_table(
@@ -117,19 +107,9 @@ def main(argv=None):
         log_ratio_columns(),
         title="\nCRBM against the best baseline, over seeds",
     )
-    write_json(
-        "fillin_baselines",
-        dict(
-            args=vars(args),
-            splits={
-                name: dict(baselines=base, crbm=crbm)
-                for name, (base, crbm) in results.items()
-            },
-            log_ratios=ratios,
-            table=table,
-        ),
-        args.output,
-    )
+    splits = {name: dict(baselines=b, crbm=c) for name, (b, c) in results.items()}
+    payload = dict(args=vars(args), splits=splits, log_ratios=ratios, table=table)
+    write_json("fillin_baselines", args.output, **payload)
     return ratios
 
 

@@ -39,21 +39,13 @@ from _common import (
     log_ratio_row,
     parser,
     print_table,
+    style_folds,
     write_json,
 )
 
 from sklearn_crbm.model_selection import make_fillin_cases
 
 N_FOLDS = 3
-
-
-def style_folds(styles, trials):
-    """Trials per fold: every ``N_FOLDS``-th walk and jog, in trial order."""
-    folds = [[] for _ in range(N_FOLDS)]
-    for style in np.unique(styles[trials]):
-        for k, trial in enumerate(t for t in trials if styles[t] == style):
-            folds[k % N_FOLDS].append(int(trial))
-    return folds
 
 
 def fold_cells(split, fold, seeds, model_params, imputer_params):
@@ -69,15 +61,10 @@ def fold_cells(split, fold, seeds, model_params, imputer_params):
         imputer, _ = crbm_imputer(X, ids, seed, model_params, imputer_params)
         for (trial, part), error in fill_errors({0: imputer}, cases)[0].items():
             style = cmu.motion[list(cmu.sequence_names).index(trial)]
-            cells.append(
-                dict(
-                    seed=seed,
-                    trial=trial,
-                    kind=f"{style}/{'leg' if part == 'left leg' else 'upper'}",
-                    error=error,
-                    best_baseline=min(row[trial, part] for row in base),
-                )
-            )
+            kind = f"{style}/{'leg' if part == 'left leg' else 'upper'}"
+            cell = dict(seed=seed, trial=trial, kind=kind, error=error)
+            best = min(row[trial, part] for row in base)
+            cells.append(dict(cell, best_baseline=best))
     return cells
 
 
@@ -110,7 +97,7 @@ def main(argv=None):
     model_params, imputer_params = json.loads(args.model), json.loads(args.imputer)
     split = Split(args.data_home, "paper")
     styles = np.asarray(split.cmu.motion)
-    folds = style_folds(styles, np.unique(split.train_ids))
+    folds = style_folds(styles, np.unique(split.train_ids), N_FOLDS)
     cells = []
     for k, fold in enumerate(folds):
         cells += fold_cells(split, fold, args.seeds, model_params, imputer_params)
@@ -119,25 +106,16 @@ def main(argv=None):
     print_table(
         per_seed,
         [
-            ("seed", "seed", "d"),
+            "seed",
             ("total", "total error", ".1f"),
             ("mean", "mean log(CRBM / best baseline)", "+.3f"),
         ],
         title="\n3-fold cross-validation on the paper split's training trials",
     )
     table = print_table(rows, log_ratio_columns(), title="\nBy kind of trial-cell")
-    write_json(
-        "fillin_cv",
-        dict(
-            args=vars(args),
-            folds=[[split.cmu.sequence_names[t] for t in f] for f in folds],
-            per_seed=per_seed,
-            log_ratios=rows,
-            cells=cells,
-            table=table,
-        ),
-        args.output,
-    )
+    names = [[split.cmu.sequence_names[t] for t in fold] for fold in folds]
+    payload = dict(args=vars(args), folds=names, per_seed=per_seed, log_ratios=rows)
+    write_json("fillin_cv", args.output, **payload, cells=cells, table=table)
     return rows
 
 

@@ -44,6 +44,7 @@ STYLES = ("walk", "jog")
 N_PER_STYLE = 6
 WINDOWS = {"200-299": 300, "900-999": 1000}  # frames judged -> their end
 AMPLITUDE_TOLERANCE, FREQUENCY_TOLERANCE = 0.25, 0.15
+VERDICTS = ("style", "amplitude", "frequency", "blown")  # kept per sequence
 
 
 def passes(corpus, generated, n_frames, end, seed_styles):
@@ -73,13 +74,8 @@ def generate_and_judge(corpus, seed, model_params):
         for style in STYLES:
             mine = seed_styles == style
             row[f"{style} {window}"] = int(passed[mine].sum())
-            details[f"{style} {window}"] = dict(
-                passes=passed[mine].tolist(),
-                style=verdict.style[mine].tolist(),
-                amplitude=verdict.amplitude[mine].tolist(),
-                frequency=verdict.frequency[mine].tolist(),
-                blown=verdict.blown[mine].tolist(),
-            )
+            judged = {key: verdict[key][mine].tolist() for key in VERDICTS}
+            details[f"{style} {window}"] = dict(passes=passed[mine].tolist(), **judged)
     return row, details
 
 
@@ -101,7 +97,7 @@ def main(argv=None):
             print(f"  {encoding} seed {seed}: {row}", flush=True)
     cells = [f"{s} {w}" for w in WINDOWS for s in STYLES]
     total = sum(row[cell] for row in rows for cell in cells)
-    columns = [("encoding", "encoding", "s"), ("seed", "seed", "d")] + [
+    columns = ["encoding", "seed"] + [
         (cell, f"{cell.replace(' ', 's pass, frames ')}", "d") for cell in cells
     ]
     table = print_table(
@@ -110,11 +106,8 @@ def main(argv=None):
         title=f"\nSequences passing (of {N_PER_STYLE} per cell): "
         f"{total} of {len(rows) * len(cells) * N_PER_STYLE} windows",
     )
-    write_json(
-        "generation_seeds",
-        dict(args=vars(args), rows=rows, passing=total, sequences=details, table=table),
-        args.output,
-    )
+    payload = dict(args=vars(args), rows=rows, passing=total, sequences=details)
+    write_json("generation_seeds", args.output, **payload, table=table)
     return rows
 
 

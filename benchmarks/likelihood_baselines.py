@@ -120,8 +120,8 @@ def main(argv=None):
     table = print_table(
         rows,
         [
-            ("split", "split", "s"),
-            ("model", "model", "s"),
+            "split",
+            "model",
             ("mean", "mean over seeds", ".2f"),
             ("low", "lowest seed", ".2f"),
             ("high", "highest seed", ".2f"),
@@ -130,11 +130,8 @@ def main(argv=None):
         ],
         title="\nHeld-out log p(x_t | past), nats per frame (forward annealing)",
     )
-    write_json(
-        "likelihood_baselines",
-        dict(args=vars(args), splits=results, table=table),
-        args.output,
-    )
+    payload = dict(args=vars(args), splits=results, table=table)
+    write_json("likelihood_baselines", args.output, **payload)
     return rows
 
 
@@ -149,9 +146,8 @@ def seed_summary(split, model, per_seed):
         gap=max(s["forward"] - s["reverse"] for s in per_seed.values()),
     )
     if "density" in model:
-        row["without_hidden"] = float(
-            np.mean([s["without_hidden"] for s in per_seed.values()])
-        )
+        without = [s["without_hidden"] for s in per_seed.values()]
+        row["without_hidden"] = float(np.mean(without))
     return row
 
 

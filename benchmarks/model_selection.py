@@ -29,13 +29,19 @@ import time
 
 import numpy as np
 import sklearn
-from _common import announce, cached_fit, parser, print_table, write_json
+from _common import (
+    announce,
+    cached_fit,
+    frozen_imputer,
+    parser,
+    print_table,
+    style_folds,
+    write_json,
+)
 from scipy.stats import spearmanr
-from sklearn.frozen import FrozenEstimator
 
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm.datasets import load_cmu35
-from sklearn_crbm.impute import CRBMImputer
 from sklearn_crbm.model_selection import erasure_mask, paper_body_parts
 from sklearn_crbm.preprocessing import make_motion_preprocessor
 
@@ -45,13 +51,8 @@ N_FOLDS = 3
 class Fold:
     """The training and held-out trials of one fold, preprocessed."""
 
-    def __init__(self, cmu, fold):
-        styles = np.asarray(cmu.motion)
-        trial_fold = np.empty(len(styles), dtype=int)
-        for style in np.unique(styles):
-            members = np.flatnonzero(styles == style)
-            trial_fold[members] = np.arange(len(members)) % N_FOLDS
-        test = trial_fold[cmu.sequence_ids] == fold
+    def __init__(self, cmu, trials):
+        test = np.isin(cmu.sequence_ids, trials)
         self.train_ids, self.test_ids = cmu.sequence_ids[~test], cmu.sequence_ids[test]
         pre = make_motion_preprocessor(cmu.skeleton)
         with sklearn.config_context(enable_metadata_routing=True):
@@ -71,12 +72,9 @@ class Fold:
             for part, bones in paper_body_parts(cmu.skeleton).items()
         }
 
-    def fillin_error(self, model, seed, imputer_params):
+    def fillin_error(self, model, seed, params):
         """Mean squared error per erased entry, the two body parts averaged."""
-        imputer = CRBMImputer(
-            FrozenEstimator(model), random_state=seed, **imputer_params
-        )
-        imputer.fit(self.Z_train, sequence_ids=self.train_ids)
+        imputer = frozen_imputer(model, self.Z_train, self.train_ids, seed, **params)
         errors = []
         for mask in self.masks.values():
             filled = imputer.transform(
@@ -112,9 +110,10 @@ def main(argv=None):
     announce()
     model_params, imputer_params = json.loads(args.model), json.loads(args.imputer)
     cmu = load_cmu35(args.data_home)
+    styles = np.asarray(cmu.motion)
     results = {}
-    for k in range(N_FOLDS):
-        fold = Fold(cmu, k)
+    for k, trials in enumerate(style_folds(styles, range(len(styles)), N_FOLDS)):
+        fold = Fold(cmu, trials)
         for order in args.orders:
             for size in args.sizes:
                 r = measure(fold, size, order, args, model_params, imputer_params)
@@ -139,16 +138,13 @@ def main(argv=None):
         title=f"\nCMU 35, {N_FOLDS} folds, {args.n_iter} epochs, seed {args.seed}",
     )
     with_history = [r for r in rows if r["order"] >= 1]
+    scores = [r["score"] for r in with_history]
+    spearman = spearmanr(scores, [-r["fillin"] for r in with_history]).statistic
     picked = max(rows, key=lambda r: r["score"])
-    best = min(r["fillin"] for r in rows)
     summary = dict(
-        spearman=float(
-            spearmanr(
-                [r["score"] for r in with_history], [-r["fillin"] for r in with_history]
-            ).statistic
-        ),
+        spearman=float(spearman),
         picked=picked["config"],
-        picked_over_best=picked["fillin"] / best,
+        picked_over_best=picked["fillin"] / min(r["fillin"] for r in rows),
         largest_time_ratio=max(r["time_ratio"] for r in rows),
     )
     print(
@@ -157,11 +153,8 @@ def main(argv=None):
         f"{summary['picked_over_best']:.3f} x the grid's best; scoring takes at "
         f"most {summary['largest_time_ratio']:.3f} x the fit's time"
     )
-    write_json(
-        "model_selection",
-        dict(args=vars(args), rows=rows, summary=summary, table=table),
-        args.output,
-    )
+    payload = dict(args=vars(args), rows=rows, summary=summary, table=table)
+    write_json("model_selection", args.output, **payload)
 
 
 if __name__ == "__main__":

@@ -34,21 +34,21 @@ from _common import (
     Split,
     announce,
     cached_fit,
+    frozen_imputer,
     log_ratio_columns,
     log_ratio_row,
     parser,
+    print_errors,
     print_table,
     write_json,
 )
 from sklearn.experimental import enable_iterative_imputer  # noqa: F401
-from sklearn.frozen import FrozenEstimator
 from sklearn.impute import IterativeImputer, KNNImputer
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm.impute import CRBMImputer, NearestNeighborImputer
+from sklearn_crbm.impute import NearestNeighborImputer
 from sklearn_crbm.model_selection import compare_imputers
 
-PAPER = {"walk/leg": (8.78, 11.68), "walk/upper": (20.52, 22.20)}
 PAPER_FILLIN = dict(n_particles=1, offset_shrinkage=None, observation_gain=1.0)
 VARIANTS = {
     "paper": (ConditionalRBM.paper_schedule, PAPER_FILLIN),
@@ -68,8 +68,7 @@ def crbm_scores(split, variant, seed, n_repeats):
     make_model, imputer_params = VARIANTS[variant]
     X = split.X_train.astype(np.float32)
     model, seconds = cached_fit(make_model(random_state=seed), X, split.train_ids)
-    imputer = CRBMImputer(FrozenEstimator(model), random_state=seed, **imputer_params)
-    imputer.fit(X, sequence_ids=split.train_ids)
+    imputer = frozen_imputer(model, X, split.train_ids, seed, **imputer_params)
     print(f"  {variant} seed {seed}: fitted in {seconds:.0f} s", flush=True)
     scores = compare_imputers(
         {0: imputer}, split.cases, n_repeats=n_repeats, random_state=seed
@@ -85,18 +84,7 @@ def main(argv=None):
     announce()
     split = Split(args.data_home, "paper")
     base = compare_imputers(baselines(split.X_train), split.cases)
-    rows = [
-        dict(method=f"paper: {name}", **dict(zip(CELLS[:2], errors, strict=True)))
-        for name, errors in zip(
-            ("CRBM", "nearest neighbour"),
-            zip(*PAPER.values(), strict=True),
-            strict=True,
-        )
-    ]
-    rows += [
-        dict(method=name, **{c: s[c]["error"] for c in CELLS})
-        for name, s in base.items()
-    ]
+    errors = {name: {c: s[c]["error"] for c in CELLS} for name, s in base.items()}
     crbm = {
         v: {s: crbm_scores(split, v, s, args.n_repeats) for s in args.seeds}
         for v in args.variants
@@ -105,33 +93,25 @@ def main(argv=None):
     summary = []
     for variant, per_seed in crbm.items():
         for seed, scores in per_seed.items():
-            rows.append(
-                dict(
-                    method=f"{variant}, seed {seed}",
-                    **{c: scores[c]["error"] for c in CELLS},
-                )
-            )
+            errors[f"{variant}, seed {seed}"] = {c: scores[c]["error"] for c in CELLS}
         for cell in CELLS:
             log_ratios = [
                 np.log(s[cell]["error"] / nearest[cell]["error"])
                 for s in per_seed.values()
             ]
             summary.append(log_ratio_row(f"{variant}, {cell}", log_ratios))
-    print_table(
-        rows,
-        [("method", "method", "s"), *((c, c, ".2f") for c in CELLS)],
-        title="\nThe paper's error (CRBM: mean of single draws), lower is better",
+    print_errors(
+        errors,
+        "\nThe paper's error (CRBM: mean of single draws), lower is better",
+        with_paper=True,
     )
     table = print_table(
         summary,
         log_ratio_columns("nearest neighbour"),
         title="\nCRBM against the paper's baseline, over seeds",
     )
-    write_json(
-        "paper_fillin",
-        dict(args=vars(args), baselines=base, crbm=crbm, summary=summary, table=table),
-        args.output,
-    )
+    payload = dict(args=vars(args), baselines=base, crbm=crbm, summary=summary)
+    write_json("paper_fillin", args.output, **payload, table=table)
 
 
 if __name__ == "__main__":

@@ -36,18 +36,20 @@ from _common import MotionCorpus, announce, cached_fit, parser, print_table, wri
 
 from sklearn_crbm import ConditionalRBM, StackedCRBM
 
+STACKED = dict(n_components=(200, 200), order=3, n_iter=500)
 MODELS = {
     "paper": lambda seed: ConditionalRBM.paper_schedule(n_iter=1000, random_state=seed),
     "defaults": lambda seed: ConditionalRBM(random_state=seed),
-    "stacked": lambda seed: StackedCRBM(
-        (200, 200), order=3, n_iter=500, random_state=seed
-    ),
+    "stacked": lambda seed: StackedCRBM(**STACKED, random_state=seed),
     "stacked-noisy": lambda seed: StackedCRBM(
-        (200, 200), order=3, n_iter=500, history_noise=0.4, random_state=seed
+        **STACKED, history_noise=0.4, random_state=seed
     ),
 }
 N_PER_STYLE, N_FRAMES = 6, 300
 WINDOW, HOP = 60, 30
+COUNTS = ("keeps", "dead", "stalled", "blown")  # sequences per style
+LABELS = ("walk", "jog", "still", "blown")  # of windows
+PARTS, DATASETS = ("styles", "transitions"), ("cmu", "mit")
 
 
 def fitted(corpus, model_name, seed):
@@ -64,10 +66,7 @@ def styles_row(corpus, model, seed):
     row, passes = {}, True
     for style in corpus.style_names:
         mine = expected == style
-        counts = {
-            k: int(verdict[k][mine].sum())
-            for k in ("keeps", "dead", "stalled", "blown")
-        }
+        counts = {k: int(verdict[k][mine].sum()) for k in COUNTS}
         row.update({f"{style} {k}": v for k, v in counts.items()})
         row[f"{style} speed"] = float(np.mean(verdict.speed[mine]))
         row[f"{style} Hz"] = float(np.nanmean(verdict.frequency[mine]))
@@ -103,21 +102,14 @@ def transitions_row(corpus, model, seed, noise, n_frames=1200):
         for a, b in zip(moving[:-1], moving[1:], strict=True):
             if a != b:
                 switches[f"{a} to {b}"] += 1
-    shares = {s: float(np.mean(labels == s)) for s in ("walk", "jog", "still", "blown")}
+    shares = {s: float(np.mean(labels == s)) for s in LABELS}
     return dict(hidden_noise=noise, seed=seed, **switches, **shares)
 
 
 def main(argv=None):
     p = parser(__doc__, seeds=(0, 1, 2))
-    p.add_argument(
-        "--parts",
-        nargs="+",
-        default=["styles", "transitions"],
-        choices=["styles", "transitions"],
-    )
-    p.add_argument(
-        "--datasets", nargs="+", default=["cmu", "mit"], choices=["cmu", "mit"]
-    )
+    p.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
+    p.add_argument("--datasets", nargs="+", default=list(DATASETS), choices=DATASETS)
     p.add_argument("--models", nargs="+", default=list(MODELS), choices=MODELS)
     p.add_argument("--noise", type=float, nargs="+", default=[0, 1, 2, 2.5, 3, 4])
     args = p.parse_args(argv)
@@ -134,28 +126,15 @@ def main(argv=None):
                     row = styles_row(corpus, fitted(corpus, model_name, seed), seed)
                     rows.append(dict(data=name, model=model_name, seed=seed, **row))
                     print(f"  {name} {model_name} seed {seed}: {row}", flush=True)
-        columns = [
-            ("data", "data", "s"),
-            ("model", "model", "s"),
-            ("seed", "seed", "d"),
-        ]
+        columns = ["data", "model", "seed"]
         for style in ("walk", "jog"):
+            columns += [(f"{style} {k}", f"{style}s {k}", "d") for k in COUNTS]
             columns += [
-                (f"{style} {k}", f"{style}s {k}", "d")
-                for k in ("keeps", "dead", "stalled", "blown")
+                (f"{style} {k}", f"{style} {k}", ".2f") for k in ("speed", "Hz")
             ]
-            columns += [
-                (f"{style} speed", f"{style} speed", ".2f"),
-                (f"{style} Hz", f"{style} Hz", ".2f"),
-            ]
-        results["styles"] = dict(
-            rows=rows,
-            table=print_table(
-                rows,
-                [*columns, ("passes", "passes", "s")],
-                title=f"\n§4.1, §5: {N_PER_STYLE} sequences per style, last 100 of {N_FRAMES} frames",
-            ),
-        )
+        title = f"\n§4.1, §5: {N_PER_STYLE} sequences per style, last 100 of {N_FRAMES} frames"
+        table = print_table(rows, [*columns, "passes"], title=title)
+        results["styles"] = dict(rows=rows, table=table)
     if "transitions" in args.parts:
         corpus = corpora.get("cmu") or MotionCorpus(args.data_home, "cmu")
         rows = [
@@ -163,22 +142,15 @@ def main(argv=None):
             for noise in args.noise
             for seed in args.seeds
         ]
-        columns = [
-            ("hidden_noise", "hidden_noise", "g"),
-            ("seed", "seed", "d"),
-            ("walk to jog", "walk to jog", "d"),
-            ("jog to walk", "jog to walk", "d"),
-        ]
-        columns += [(s, f"share {s}", ".2f") for s in ("walk", "jog", "still", "blown")]
-        results["transitions"] = dict(
-            rows=rows,
-            table=print_table(
-                rows,
-                columns,
-                title=f"\n§4.3: {2 * N_PER_STYLE} sequences of 1200 frames, windows of {WINDOW}",
-            ),
+        noise = ("hidden_noise", "hidden_noise", "g")
+        shares = [(s, f"share {s}", ".2f") for s in LABELS]
+        columns = [noise, "seed", "walk to jog", "jog to walk", *shares]
+        title = (
+            f"\n§4.3: {2 * N_PER_STYLE} sequences of 1200 frames, windows of {WINDOW}"
         )
-    write_json("paper_generation", dict(args=vars(args), **results), args.output)
+        table = print_table(rows, columns, title=title)
+        results["transitions"] = dict(rows=rows, table=table)
+    write_json("paper_generation", args.output, args=vars(args), **results)
 
 
 if __name__ == "__main__":

@@ -3,74 +3,61 @@
 Data: the Bandai Namco walks in seven styles (``load_bandai_walks``: takes
 001-006 of active, elderly, exhausted, feminine, masculine, normal and
 youthful, 30 frames per second), through the default
-``make_motion_preprocessor`` fitted on each split's training frames.
-
-Splits:
-
-``held-out``
-    Takes 001-005 of every style train; the takes 006 are held out.
-``one take``
-    For each style in turn: only its take 001 and all six takes of the
-    other styles train; its takes 002-006 are held out.
+``make_motion_preprocessor`` fitted on each split's training frames.  Splits:
+``held-out`` trains on takes 001-005 of every style and holds out the takes
+006; ``one take``, for each style in turn, trains on its take 001 and all
+six takes of the other styles and holds out its takes 002-006.
 
 Candidates (``--candidates``), each trained per seed of ``--seeds`` with the
-package's defaults (``--n-iter`` shortens training):
+package's defaults (``--n-iter`` shortens training); each is a subclass of
+:class:`Candidate` and an entry in ``CANDIDATES``:
 
-``unlabelled``
-    (a) one ``ConditionalRBM`` on every style, without the labels: its style
-    is the style of the frames that seed it.
-``separate``
-    (b) seven ``ConditionalRBM``, one per style; a transition switches from
-    one model to the other, a blend is beyond it.
-
-A candidate is a subclass of :class:`Candidate`; adding one (the
-``FactoredCRBM``, or a CRBM with the labels as additive inputs) is a class
-of a few lines and an entry in ``CANDIDATES``.
+- ``factored``: ``FactoredCRBM``, the labels gate every interaction;
+- ``unlabelled``: (a) one ``ConditionalRBM`` on every style, without the
+  labels: its style is the style of the frames that seed it;
+- ``separate``: (b) seven ``ConditionalRBM``, one per style; a transition
+  switches from one model to the other, a blend is beyond it;
+- ``labelled``: (c) ``LabelledCRBM``, the labels as additive inputs to the
+  dynamic biases.
 
 Measurements (the issue's "Done when"), each of ``--parts``:
 
-``style``
-    Per style, ``--n-sequences`` sequences of ``--n-frames`` frames seeded
-    with real frames of a *normal* walk and asked for the style (the
-    unlabelled model, which cannot be asked, also seeded with frames of the
-    style itself): the share of 2-s windows from frame 100 on that the
-    judge (``StyleJudge`` trained on all 42 real takes) calls the style
-    ("kept"), the share also alive, and over the last 100 frames the leg
-    amplitude and step frequency of every sequence as a ratio to the
-    style's real 100-frame windows (pass: within 25% and 15%); blow-ups
-    (a channel beyond twice its largest magnitude in the real takes, whose
-    toes reach 13.5 standard deviations).
-``blends``
-    The 21 pairs of styles at 50/50: windows judged as one of the two;
-    forward speed and step frequency between the two styles' real ones
-    (within 10% of their difference).
-``transitions``
-    The 42 ordered pairs, seeded with frames of the first style, switched
-    to the second at half the sequence: windows from 60 frames after the
-    switch judged as the new style, and alive.
-``likelihood``
-    Held-out log-likelihood per frame of the takes 006 with their labels
-    (frames from the 13th of each take, so that every order up to 12 has a
-    full history), with the standard error of the annealed estimate and the
-    gap to the reverse (conservative) estimate.
-``recognition``
-    The style of the first 300 frames of every take 006: by Bayes' rule
-    from the per-frame log-likelihoods under each style, equal priors.
-``fillin``
-    The left leg (``UpperLeg_L`` down) or the upper body (``Spine`` up) of
-    every take 006 erased from half-way: the log ratio of the paper's
-    fill-in error to the best of ``KNNImputer(5)``, ``KNNImputer(10)`` and
-    ``AutoregressiveImputer()``, averaged over styles, parts and seeds, with
-    a 95% bootstrap interval.
-``one-take``
-    The one-take split: for every style, the share of windows kept and
-    alive (the unlabelled model seeded with frames of its take 001, the
-    others with a normal walk's), and the held-out log-likelihood of its
-    takes 002-006 (for ``separate``: of the CRBM trained on that one take).
-``speed``
-    Training seconds per epoch (``separate``: its seven models together);
-    generation frames per second for one sequence and per sequence of 100
-    generated together (the default Gibbs steps).
+- ``style``: per style, ``--n-sequences`` sequences of ``--n-frames``
+  frames seeded with real frames of a *normal* walk and asked for the style
+  (the unlabelled model, which cannot be asked, also seeded with frames of
+  the style itself): the share of 2-s windows from frame 100 on that the
+  judge (``StyleJudge`` trained on all 42 real takes) calls the style
+  ("kept"), the share also alive, and over the last 100 frames the leg
+  amplitude and step frequency of every sequence as a ratio to the style's
+  real 100-frame windows (pass: within 25% and 15%); blow-ups (a channel
+  beyond twice its largest magnitude in the real takes, whose toes reach
+  13.5 standard deviations).
+- ``blends``: the 21 pairs of styles at 50/50: windows judged as one of the
+  two; forward speed and step frequency between the two styles' real ones
+  (within 10% of their difference).
+- ``transitions``: the 42 ordered pairs, seeded with frames of the first
+  style, switched to the second at half the sequence: windows from 60
+  frames after the switch judged as the new style, and alive.
+- ``likelihood``: held-out log-likelihood per frame of the takes 006 with
+  their labels (frames from the 13th of each take, so that every order up
+  to 12 has a full history), with the standard error of the annealed
+  estimate and the gap to the reverse (conservative) estimate.
+- ``recognition``: the style of the first 300 frames of every take 006: by
+  Bayes' rule from the per-frame log-likelihoods under each style, equal
+  priors.
+- ``fillin``: the left leg (``UpperLeg_L`` down) or the upper body
+  (``Spine`` up) of every take 006 erased from half-way: the log ratio of
+  the paper's fill-in error to the best of ``KNNImputer(5)``,
+  ``KNNImputer(10)`` and ``AutoregressiveImputer()``, averaged over styles,
+  parts and seeds, with a 95% bootstrap interval.
+- ``one-take``: the one-take split: for every style, the share of windows
+  kept and alive (the unlabelled model seeded with frames of its take 001,
+  the others with a normal walk's), and the held-out log-likelihood of its
+  takes 002-006 (for ``separate``: of the CRBM trained on that one take).
+- ``speed``: training seconds per epoch (``separate``: its seven models
+  together); generation frames per second for one sequence and per sequence
+  of 100 generated together (the default Gibbs steps); for the labelled
+  models, one epoch against its matrix products alone.
 
 Run from the repository root, e.g.::
 
@@ -87,40 +74,33 @@ import os
 for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_name, "1")
 
-import argparse  # noqa: E402
 import itertools  # noqa: E402
 import json  # noqa: E402
-import time  # noqa: E402
 from abc import ABC, abstractmethod  # noqa: E402
-from dataclasses import dataclass  # noqa: E402
+from functools import partial  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
-from sklearn.frozen import FrozenEstimator  # noqa: E402
+from _common import (  # noqa: E402
+    RESULTS,
+    bootstrap_mean,
+    frames_with_history,
+    frozen_imputer,
+    parser,
+    print_table,
+    seconds,
+)
 from sklearn.impute import KNNImputer  # noqa: E402
 
-from sklearn_crbm import (  # noqa: E402
-    ConditionalRBM,
-    CRBMImputer,
-    FactoredCRBM,
-    LabelledCRBM,
-)
+from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM  # noqa: E402
 from sklearn_crbm.datasets import bone_columns, load_bandai_walks  # noqa: E402
 from sklearn_crbm.impute import AutoregressiveImputer  # noqa: E402
-from sklearn_crbm.metrics import (  # noqa: E402
-    StyleJudge,
-    forward_speed,
-    step_frequency,
-)
-from sklearn_crbm.model_selection import (  # noqa: E402
-    make_fillin_cases,
-    paper_body_parts,
-)
+from sklearn_crbm.metrics import StyleJudge, forward_speed, step_frequency  # noqa: E402
+from sklearn_crbm.model_selection import make_fillin_cases, paper_body_parts  # noqa: E402
 from sklearn_crbm.preprocessing import make_motion_preprocessor  # noqa: E402
 from sklearn_crbm.utils import random_windows  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[1]
 FRAME_RATE = 30.0
 NORMAL = "normal"
 LEGS = ("UpperLeg_L", "UpperLeg_R", "LowerLeg_L", "LowerLeg_R")
@@ -131,98 +111,66 @@ LAST_FRAMES = 100  # frames of the amplitude and frequency check
 SCORED_FROM = 12  # frames of each held-out take not scored (full histories)
 RECOGNITION_FRAMES = 300
 BLOWN_UP = 2.0  # a channel beyond this times its largest real |z| has blown up
-PARTS = (
-    "style",
-    "blends",
-    "transitions",
-    "likelihood",
-    "recognition",
-    "fillin",
-    "one-take",
-    "speed",
+PARTS = tuple(
+    "style blends transitions likelihood recognition fillin one-take speed".split()
 )
 
 
 # ------------------------------------------------------------------- data
-@dataclass
 class Split:
-    """One split, preprocessed, with the instruments that judge its motion."""
+    """One split of ``walks``, preprocessed, with the instruments that judge motion.
 
-    styles: list  # the style names, in the order of the label weights
-    pre: object  # the fitted preprocessor
-    walks: object  # load_bandai_walks()
-    train: np.ndarray  # frames (rows of walks.data) that train
-    test: np.ndarray  # frames held out
-    Z: np.ndarray  # every take, preprocessed
-    legs: np.ndarray  # columns of the hips and knees
-    limit: np.ndarray  # per channel, |z| beyond which motion has blown up
-    judge: StyleJudge  # 2-s windows: style, and alive
-    pace: StyleJudge  # 100-frame windows: amplitude and frequency references
-    real_speed: dict  # style: mean forward speed of its real takes
-    real_frequency: dict  # style: step frequency (Hz) of its real takes
+    ``train`` and ``test`` are masks of the frames (rows of ``walks.data``);
+    ``Z`` is every take preprocessed; ``styles`` are the style names in the
+    order of the label weights; ``judge`` calls the style of 2-s windows and
+    whether they are alive, ``pace`` gives the amplitude and frequency of
+    100-frame windows against the real ones; ``limit`` is the |z| per channel
+    beyond which motion has blown up; ``real_speed`` and ``real_frequency``
+    (Hz) are the means of the real takes of every style.
+    """
+
+    def __init__(self, walks, train):
+        self.walks, self.train, self.test = walks, train, ~train
+        self.styles = styles = sorted(walks.target_names)
+        ids = walks.sequence_ids
+        with sklearn.config_context(enable_metadata_routing=True):
+            self.pre = make_motion_preprocessor(walks.skeleton)
+            self.pre.fit(walks.data[train], sequence_ids=ids[train])
+            self.Z = Z = self.pre.transform(walks.data, sequence_ids=ids)
+        names = self.pre.get_feature_names_out()
+        self.legs = legs = bone_columns(names, LEGS)
+        labels = walks.target_names[walks.target]
+        self.judge = StyleJudge(legs=legs).fit(Z, labels, sequence_ids=ids)
+        self.pace = StyleJudge(window=LAST_FRAMES, stride=10, legs=legs)
+        self.pace.fit(Z, labels, sequence_ids=ids)
+        self.limit = BLOWN_UP * np.abs(Z).max(axis=0)
+        speed = forward_speed(Z, sequence_ids=ids, feature_names=names)
+        frequency = step_frequency(
+            Z, sequence_ids=ids, features=legs, frame_rate=FRAME_RATE
+        )
+        take_styles = labels[np.searchsorted(ids, np.arange(ids.max() + 1))]
+        self.real_speed = {s: float(speed[take_styles == s].mean()) for s in styles}
+        self.real_frequency = {
+            s: float(frequency[take_styles == s].mean()) for s in styles
+        }
 
     def frames(self, rows):
         """``(Z, styles, sequence_ids)`` of the given rows."""
         walks = self.walks
-        return (
-            self.Z[rows],
-            walks.target_names[walks.target[rows]],
-            walks.sequence_ids[rows],
+        styles = walks.target_names[walks.target[rows]]
+        return self.Z[rows], styles, walks.sequence_ids[rows]
+
+    def seed_windows(self, style, width, n_windows, rng):
+        """``n_windows`` windows of ``width`` real training frames of ``style``."""
+        Z, styles, ids = self.frames(self.train)
+        return random_windows(
+            Z,
+            sequence_ids=ids,
+            width=width,
+            n_windows=n_windows,
+            sequences=np.unique(ids[styles == style]),
+            random_state=rng,
         )
-
-    def takes_of(self, style, rows):
-        """Sequence ids of the takes of ``style`` among ``rows``."""
-        Z, styles, ids = self.frames(rows)
-        return np.unique(ids[styles == style])
-
-
-def make_split(walks, train):
-    """The split that trains on the frames ``train`` and holds out the rest."""
-    styles = sorted(walks.target_names)  # the columns of the label weights
-    ids = walks.sequence_ids
-    with sklearn.config_context(enable_metadata_routing=True):
-        pre = make_motion_preprocessor(walks.skeleton)
-        pre.fit(walks.data[train], sequence_ids=ids[train])
-        Z = pre.transform(walks.data, sequence_ids=ids)
-    names = pre.get_feature_names_out()
-    legs = bone_columns(names, LEGS)
-    labels = walks.target_names[walks.target]
-    judge = StyleJudge(legs=legs).fit(Z, labels, sequence_ids=ids)
-    pace = StyleJudge(window=LAST_FRAMES, stride=10, legs=legs).fit(
-        Z, labels, sequence_ids=ids
-    )
-    speed = forward_speed(Z, sequence_ids=ids, feature_names=names)
-    frequency = step_frequency(
-        Z, sequence_ids=ids, features=legs, frame_rate=FRAME_RATE
-    )
-    take_styles = labels[np.searchsorted(ids, np.arange(ids.max() + 1))]
-    return Split(
-        styles=styles,
-        pre=pre,
-        walks=walks,
-        train=train,
-        test=~train,
-        Z=Z,
-        legs=legs,
-        limit=BLOWN_UP * np.abs(Z).max(axis=0),
-        judge=judge,
-        pace=pace,
-        real_speed={s: float(speed[take_styles == s].mean()) for s in styles},
-        real_frequency={s: float(frequency[take_styles == s].mean()) for s in styles},
-    )
-
-
-def seed_windows(split, style, width, n_windows, rng):
-    """``n_windows`` windows of ``width`` real training frames of ``style``."""
-    Z, _, ids = split.frames(split.train)
-    return random_windows(
-        Z,
-        sequence_ids=ids,
-        width=width,
-        n_windows=n_windows,
-        sequences=split.takes_of(style, split.train),
-        random_state=rng,
-    )
 
 
 def label_weights(styles, n_frames, first, second=None, switch=None, blend=None):
@@ -239,27 +187,58 @@ def label_weights(styles, n_frames, first, second=None, switch=None, blend=None)
 
 
 # ------------------------------------------------------------- candidates
+CRBM_PARAMETERS = (
+    "components_ intercept_hidden_ intercept_visible_ autoregressive_ past_to_hidden_"
+).split()
+
+
+def _new(estimator, seed, n_iter):
+    """``estimator`` with the package's defaults (but ``n_iter`` if given)."""
+    model = estimator(random_state=seed)
+    return model if n_iter is None else model.set_params(n_iter=n_iter)
+
+
+def _n_parameters(model, names=CRBM_PARAMETERS):
+    return sum(getattr(model, name).size for name in names if hasattr(model, name))
+
+
+def _estimate(model, Z, sequence_ids, seed, labels=()):
+    """Per frame ``(estimate, standard error, reverse estimate)``."""
+    result = model.estimate_log_likelihood(
+        Z, *labels, sequence_ids=sequence_ids, reverse=True, random_state=seed
+    )
+    return result.log_likelihood, result.standard_error, result.lower
+
+
+def _filler(model, Z, sequence_ids, seed, labels=(), **transform_params):
+    """``frozen_imputer(model, Z, ...).transform``, with ``transform_params``."""
+    imputer = frozen_imputer(model, Z, sequence_ids, seed, *labels)
+    return partial(imputer.transform, **transform_params)
+
+
 class Candidate(ABC):
-    """A model of many styles, as the benchmark drives it."""
+    """A model of many styles, as the benchmark drives it.
+
+    ``fit(Z, styles, sequence_ids, seed=, n_iter=, only=)`` trains on
+    labelled frames; ``only``: the styles that will be asked for.  The
+    columns of the label weights that generation follows are the sorted
+    styles, as a classifier's ``classes_``.
+    """
 
     name = ""
     controls_style = True  # False: its style is that of the frames seeding it
 
     @abstractmethod
     def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
-        """Train on labelled frames; ``only``: the styles that will be asked for.
+        """Train on labelled frames; returns ``self``."""
 
-        The columns of the label weights that generation follows are the
-        sorted styles, as a classifier's ``classes_``.
-        """
-
-    @abstractmethod
     def history_length(self):
         """Seed frames that generation needs."""
+        return self.model.history_length
 
-    @abstractmethod
     def can_generate(self, weights):
         """Whether it can follow these per-frame label weights."""
+        return True
 
     @abstractmethod
     def generate(self, weights, history, random_state):
@@ -273,39 +252,13 @@ class Candidate(ABC):
         """The style of every sequence, or None if it cannot tell."""
         return None
 
-    @abstractmethod
-    def imputer(self, style, Z, sequence_ids, seed):
-        """A fitted imputer for sequences of ``style`` (trained on ``Z``)."""
+    def filler(self, style, Z, sequence_ids, seed):
+        """Fills sequences of ``style``: ``filler(X_missing)`` (trained on ``Z``)."""
+        return _filler(self.model, Z, sequence_ids, seed)
 
-    @abstractmethod
     def n_parameters(self):
         """Number of trained parameters."""
-
-
-def _crbm_parameters(model):
-    return sum(
-        getattr(model, name).size
-        for name in (
-            "components_",
-            "intercept_hidden_",
-            "intercept_visible_",
-            "autoregressive_",
-            "past_to_hidden_",
-        )
-    )
-
-
-def _crbm(seed, n_iter):
-    """A ConditionalRBM with the package's defaults (but ``n_iter`` if given)."""
-    model = ConditionalRBM(random_state=seed)
-    return model if n_iter is None else model.set_params(n_iter=n_iter)
-
-
-def _estimate(model, Z, sequence_ids, seed):
-    result = model.estimate_log_likelihood(
-        Z, sequence_ids=sequence_ids, reverse=True, random_state=seed
-    )
-    return result.log_likelihood, result.standard_error, result.lower
+        return _n_parameters(self.model)
 
 
 class Unlabelled(Candidate):
@@ -315,11 +268,9 @@ class Unlabelled(Candidate):
     controls_style = False
 
     def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
-        self.model = _crbm(seed, n_iter).fit(Z, sequence_ids=sequence_ids)
+        self.model = _new(ConditionalRBM, seed, n_iter)
+        self.model.fit(Z, sequence_ids=sequence_ids)
         return self
-
-    def history_length(self):
-        return self.model.history_length
 
     def can_generate(self, weights):
         # it ignores them, so it only makes sense for one style throughout
@@ -333,13 +284,6 @@ class Unlabelled(Candidate):
     def log_likelihood(self, Z, styles, sequence_ids, seed):
         return _estimate(self.model, Z, sequence_ids, seed)
 
-    def imputer(self, style, Z, sequence_ids, seed):
-        imputer = CRBMImputer(FrozenEstimator(self.model), random_state=seed)
-        return imputer.fit(Z, sequence_ids=sequence_ids)
-
-    def n_parameters(self):
-        return _crbm_parameters(self.model)
-
 
 class Separate(Candidate):
     """(b) One ConditionalRBM per style; a transition switches models."""
@@ -348,12 +292,11 @@ class Separate(Candidate):
 
     def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
         self.classes_ = np.unique(styles)
-        wanted = self.classes_ if only is None else only
         self.models = {
-            style: _crbm(seed, n_iter).fit(
+            style: _new(ConditionalRBM, seed, n_iter).fit(
                 Z[styles == style], sequence_ids=sequence_ids[styles == style]
             )
-            for style in wanted
+            for style in (self.classes_ if only is None else only)
         }
         return self
 
@@ -386,34 +329,20 @@ class Separate(Candidate):
         return estimate, error, lower
 
     def recognise(self, Z, sequence_ids, styles, seed):
-        scored = _scored_frames(sequence_ids)
+        scored = frames_with_history(sequence_ids, SCORED_FROM)
+        takes = np.unique(sequence_ids)
         totals = []
         for style in styles:
             estimate = _estimate(self.models[style], Z, sequence_ids, seed)[0]
-            totals.append(
-                [
-                    estimate[scored & (sequence_ids == k)].sum()
-                    for k in np.unique(sequence_ids)
-                ]
-            )
+            estimate, ids = estimate[scored], sequence_ids[scored]
+            totals.append([estimate[ids == k].sum() for k in takes])
         return np.asarray(styles, dtype=object)[np.argmax(totals, axis=0)]
 
-    def imputer(self, style, Z, sequence_ids, seed):
-        imputer = CRBMImputer(FrozenEstimator(self.models[style]), random_state=seed)
-        return imputer.fit(Z, sequence_ids=sequence_ids)
+    def filler(self, style, Z, sequence_ids, seed):
+        return _filler(self.models[style], Z, sequence_ids, seed)
 
     def n_parameters(self):
-        return sum(_crbm_parameters(model) for model in self.models.values())
-
-
-class _GivenStyle:
-    """A fitted CRBMImputer that fills every sequence in one given style."""
-
-    def __init__(self, imputer, style):
-        self.imputer, self.style = imputer, style
-
-    def transform(self, X):
-        return self.imputer.transform(X, style=self.style)
+        return sum(_n_parameters(model) for model in self.models.values())
 
 
 class StyleModel(Candidate):
@@ -423,18 +352,10 @@ class StyleModel(Candidate):
     parameters = ()  # its fitted arrays, for the count of parameters
 
     def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
-        model = self.estimator(random_state=seed)
-        if n_iter is not None:
-            model.set_params(n_iter=n_iter)
-        self.model = model.fit(Z, styles, sequence_ids=sequence_ids)
+        self.model = _new(self.estimator, seed, n_iter)
+        self.model.fit(Z, styles, sequence_ids=sequence_ids)
         self.styles = styles
         return self
-
-    def history_length(self):
-        return self.model.history_length
-
-    def can_generate(self, weights):
-        return True
 
     def generate(self, weights, history, random_state):
         return self.model.sample(
@@ -442,10 +363,7 @@ class StyleModel(Candidate):
         )
 
     def log_likelihood(self, Z, styles, sequence_ids, seed):
-        result = self.model.estimate_log_likelihood(
-            Z, styles, sequence_ids=sequence_ids, reverse=True, random_state=seed
-        )
-        return result.log_likelihood, result.standard_error, result.lower
+        return _estimate(self.model, Z, sequence_ids, seed, labels=(styles,))
 
     def recognise(self, Z, sequence_ids, styles, seed):
         named = self.model.set_params(random_state=seed).predict(
@@ -455,18 +373,12 @@ class StyleModel(Candidate):
             [named[sequence_ids == k][0] for k in np.unique(sequence_ids)], dtype=object
         )
 
-    def imputer(self, style, Z, sequence_ids, seed):
-        imputer = CRBMImputer(FrozenEstimator(self.model), random_state=seed)
-        return _GivenStyle(
-            imputer.fit(Z, self.styles, sequence_ids=sequence_ids), style
-        )
+    def filler(self, style, Z, sequence_ids, seed):
+        labels = (self.styles,)
+        return _filler(self.model, Z, sequence_ids, seed, labels, style=style)
 
     def n_parameters(self):
-        return sum(
-            getattr(self.model, name).size
-            for name in self.parameters
-            if hasattr(self.model, name)
-        )
+        return _n_parameters(self.model, self.parameters)
 
 
 class Factored(StyleModel):
@@ -475,20 +387,11 @@ class Factored(StyleModel):
     name = "factored"
     estimator = FactoredCRBM
     parameters = (
-        "visible_factors_",
-        "hidden_factors_",
-        "past_visible_factors_",
-        "visible_from_factors_",
-        "past_hidden_factors_",
-        "hidden_from_factors_",
-        "label_features_",
-        "style_factors_",
-        "style_undirected_",
-        "style_hidden_",
-        "style_visible_",
-        "intercept_hidden_",
-        "intercept_visible_",
-    )
+        "visible_factors_ hidden_factors_ past_visible_factors_ visible_from_factors_ "
+        "past_hidden_factors_ hidden_from_factors_ label_features_ style_factors_ "
+        "style_undirected_ style_hidden_ style_visible_ intercept_hidden_ "
+        "intercept_visible_"
+    ).split()
 
 
 class Labelled(StyleModel):
@@ -496,15 +399,7 @@ class Labelled(StyleModel):
 
     name = "labelled"
     estimator = LabelledCRBM
-    parameters = (
-        "components_",
-        "intercept_hidden_",
-        "intercept_visible_",
-        "autoregressive_",
-        "past_to_hidden_",
-        "label_to_visible_",
-        "label_to_hidden_",
-    )
+    parameters = (*CRBM_PARAMETERS, "label_to_visible_", "label_to_hidden_")
 
 
 CANDIDATES = {
@@ -514,15 +409,6 @@ CANDIDATES = {
 
 
 # ----------------------------------------------------------- measurements
-def _scored_frames(sequence_ids):
-    """Frames with at least SCORED_FROM frames before them in their sequence."""
-    starts = np.r_[0, np.flatnonzero(np.diff(sequence_ids)) + 1]
-    position = np.arange(len(sequence_ids)) - np.repeat(
-        starts, np.diff(np.r_[starts, len(sequence_ids)])
-    )
-    return position >= SCORED_FROM
-
-
 def _draw_seed(rng):
     """An int seed from ``rng`` (the estimators take ints or RandomStates)."""
     return int(rng.integers(np.iinfo(np.int32).max))
@@ -532,15 +418,23 @@ def generated_ids(n_sequences, n_frames):
     return np.repeat(np.arange(n_sequences), n_frames)
 
 
+def generate(candidate, split, weights, seed_style, args, rng):
+    """Sequences following ``weights``, seeded with real frames of ``seed_style``."""
+    width = candidate.history_length()
+    history = split.seed_windows(seed_style, width, args.n_sequences, rng)
+    return candidate.generate(weights, history, _draw_seed(rng))
+
+
 def _blown_up(split, frames, n_sequences):
     """Sequences with a value beyond its channel's limit (or not finite)."""
     beyond = ~(np.abs(frames) <= split.limit)  # NaN counts as beyond
     return beyond.reshape(n_sequences, -1).any(axis=1)
 
 
-def judge_generated(split, frames, weights, n_sequences):
-    """Windows judged, kept and alive; last frames' pace; blow-ups."""
-    n_frames = len(weights)
+def generate_judged(candidate, split, weights, seed_style, args, rng):
+    """Generate, then judge: windows (kept, alive), last frames' pace, blow-ups."""
+    frames = generate(candidate, split, weights, seed_style, args, rng)
+    n_sequences, n_frames = args.n_sequences, len(weights)
     ids = generated_ids(n_sequences, n_frames)
     requested = np.asarray(split.styles, dtype=object)[np.argmax(weights, axis=1)]
     blown = _blown_up(split, frames, n_sequences)
@@ -557,6 +451,18 @@ def judge_generated(split, frames, weights, n_sequences):
     return verdict, pace, blown
 
 
+def kept_cell(verdict, pace, blown, **more):
+    """Windows kept (and alive) from JUDGED_FROM on, ``more``, pace and blow-ups."""
+    judged = verdict.starts >= JUDGED_FROM
+    return dict(
+        kept=float(verdict.correct[judged].mean()),
+        kept_alive=float(verdict.accepted[judged].mean()),
+        **more,
+        pace_ok=int(np.sum(pace.alive)),
+        blown_up=int(blown.sum()),
+    )
+
+
 def style_kept(candidate, split, args, rng):
     """Per style: windows kept and alive, last-frame pace, blow-ups."""
     rows = {}
@@ -566,25 +472,15 @@ def style_kept(candidate, split, args, rng):
     for seed_style, label in seeds:
         for style in split.styles:
             weights = label_weights(split.styles, args.n_frames, style)
-            history = seed_windows(
-                split,
-                seed_style or style,
-                candidate.history_length(),
-                args.n_sequences,
-                rng,
+            verdict, pace, blown = generate_judged(
+                candidate, split, weights, seed_style or style, args, rng
             )
-            frames = candidate.generate(weights, history, _draw_seed(rng))
-            verdict, pace, blown = judge_generated(
-                split, frames, weights, args.n_sequences
-            )
-            judged = verdict.starts >= JUDGED_FROM
-            rows.setdefault(label, {})[style] = dict(
-                kept=float(verdict.correct[judged].mean()),
-                kept_alive=float(verdict.accepted[judged].mean()),
+            rows.setdefault(label, {})[style] = kept_cell(
+                verdict,
+                pace,
+                blown,
                 amplitude_ratio=pace.amplitude_ratio.tolist(),
                 frequency_ratio=pace.frequency_ratio.tolist(),
-                pace_ok=int(np.sum(pace.alive)),
-                blown_up=int(blown.sum()),
             )
     return rows
 
@@ -596,45 +492,33 @@ def blends(candidate, split, args, rng):
         weights = label_weights(split.styles, args.n_frames, first, second, blend=0.5)
         if not candidate.can_generate(weights):
             return None
-        history = seed_windows(
-            split, NORMAL, candidate.history_length(), args.n_sequences, rng
-        )
-        frames = candidate.generate(weights, history, _draw_seed(rng))
+        frames = generate(candidate, split, weights, NORMAL, args, rng)
         blown = _blown_up(split, frames, args.n_sequences)
         frames = np.where(np.isfinite(frames), frames, 0.0)
         ids = generated_ids(args.n_sequences, args.n_frames)
         verdict = split.judge.verdict(frames, sequence_ids=ids)
         judged = verdict.starts >= JUDGED_FROM
         later = np.tile(np.arange(args.n_frames) >= JUDGED_FROM, args.n_sequences)
-        speed = forward_speed(
-            frames[later], sequence_ids=ids[later], feature_names=names
-        )
+        frames, ids = frames[later], ids[later]
+        speed = forward_speed(frames, sequence_ids=ids, feature_names=names)
         frequency = step_frequency(
-            frames[later],
-            sequence_ids=ids[later],
-            features=split.legs,
-            frame_rate=FRAME_RATE,
+            frames, sequence_ids=ids, features=split.legs, frame_rate=FRAME_RATE
         )
-        between = [
-            _between(np.mean(value), real[first], real[second])
-            for value, real in (
-                (speed, split.real_speed),
-                (frequency, split.real_frequency),
-            )
-        ]
+        one_of_two = np.isin(verdict.predicted[judged], [first, second]).mean()
         cells[f"{first}/{second}"] = dict(
-            one_of_two=float(
-                np.isin(verdict.predicted[judged], [first, second]).mean()
+            one_of_two=float(one_of_two),
+            speed_between=_between(np.mean(speed), split.real_speed, first, second),
+            frequency_between=_between(
+                np.mean(frequency), split.real_frequency, first, second
             ),
-            speed_between=between[0],
-            frequency_between=between[1],
             blown_up=int(blown.sum()),
         )
     return cells
 
 
-def _between(value, a, b, margin=0.1):
-    low, high = min(a, b), max(a, b)
+def _between(value, real, first, second, margin=0.1):
+    """Whether ``value`` lies between the real values of two styles (or near)."""
+    low, high = sorted((real[first], real[second]))
     return bool(low - margin * (high - low) <= value <= high + margin * (high - low))
 
 
@@ -647,11 +531,7 @@ def transitions(candidate, split, args, rng):
         )
         if not candidate.can_generate(weights):
             return None
-        history = seed_windows(
-            split, first, candidate.history_length(), args.n_sequences, rng
-        )
-        frames = candidate.generate(weights, history, _draw_seed(rng))
-        verdict, _, blown = judge_generated(split, frames, weights, args.n_sequences)
+        verdict, _, blown = generate_judged(candidate, split, weights, first, args, rng)
         judged = verdict.starts >= switch + AFTER_SWITCH
         cells[f"{first}->{second}"] = dict(
             new_style=float(verdict.correct[judged].mean()),
@@ -664,12 +544,12 @@ def transitions(candidate, split, args, rng):
 def likelihood(candidate, split, rows, seed):
     Z, styles, ids = split.frames(rows)
     estimate, error, lower = candidate.log_likelihood(Z, styles, ids, seed)
-    scored = _scored_frames(ids)
+    scored = frames_with_history(ids, SCORED_FROM)
     return dict(
         mean=float(estimate[scored].mean()),
-        standard_error=float(np.sqrt(np.sum(error[scored] ** 2)) / scored.sum()),
+        standard_error=float(np.sqrt(np.sum(error[scored] ** 2)) / len(scored)),
         reverse_gap=float(np.mean(estimate[scored] - lower[scored])),
-        n_frames=int(scored.sum()),
+        n_frames=len(scored),
     )
 
 
@@ -696,24 +576,23 @@ def fillin(candidate, split, seed):
         AutoregressiveImputer().fit(Z, sequence_ids=ids),
     ]
     walks = split.walks
-    held_out = {
-        walks.target_names[
-            walks.target[walks.sequence_ids == k][0]
-        ]: walks.sequence_names[k]
-        for k in np.unique(walks.sequence_ids[split.test])
-    }
+    takes = np.unique(walks.sequence_ids[split.test])
+    styles = walks.target_names[
+        walks.target[np.searchsorted(walks.sequence_ids, takes)]
+    ]
+    held_out = {s: walks.sequence_names[k] for s, k in zip(styles, takes, strict=True)}
     cases = make_fillin_cases(
         walks,
         split.pre,
         trials=held_out,
         body_parts=paper_body_parts(walks.skeleton, **BODY_PARTS),
     )
-    ratios, imputers = {}, {}
+    ratios, fillers = {}, {}
     for (style, part), case in cases.items():
         best = min(case.errors(b.transform(case.X_missing))[0] for b in baselines)
-        if style not in imputers:
-            imputers[style] = candidate.imputer(style, Z, ids, seed)
-        filled = imputers[style].transform(case.X_missing)
+        if style not in fillers:
+            fillers[style] = candidate.filler(style, Z, ids, seed)
+        filled = fillers[style](case.X_missing)
         ratios[f"{style}/{part}"] = float(np.log(case.errors(filled)[0] / best))
     return ratios
 
@@ -725,25 +604,19 @@ def one_take(name, walks, args, seed, rng):
     takes = walks.takes[walks.sequence_ids]
     for style in walks.target_names:
         train = (labels != style) | (takes == 1)
-        split = make_split(walks, train)
+        split = Split(walks, train)
         Z, styles, ids = split.frames(train)
         candidate = CANDIDATES[name]().fit(
             Z, styles, ids, seed=seed, n_iter=args.n_iter, only=[style]
         )
         weights = label_weights(split.styles, args.n_frames, style)
         seed_style = NORMAL if candidate.controls_style else style
-        history = seed_windows(
-            split, seed_style, candidate.history_length(), args.n_sequences, rng
+        verdict, pace, blown = generate_judged(
+            candidate, split, weights, seed_style, args, rng
         )
-        frames = candidate.generate(weights, history, _draw_seed(rng))
-        verdict, pace, blown = judge_generated(split, frames, weights, args.n_sequences)
-        judged = verdict.starts >= JUDGED_FROM
+        log_likelihood = likelihood(candidate, split, ~train, seed)
         cells[style] = dict(
-            kept=float(verdict.correct[judged].mean()),
-            kept_alive=float(verdict.accepted[judged].mean()),
-            pace_ok=int(np.sum(pace.alive)),
-            blown_up=int(blown.sum()),
-            log_likelihood=likelihood(candidate, split, ~train, seed),
+            kept_cell(verdict, pace, blown), log_likelihood=log_likelihood
         )
         print(f"    one take, {style}: {cells[style]['kept']:.0%} kept", flush=True)
     return cells
@@ -754,12 +627,11 @@ def speed(candidate, split, n_frames_trained, n_iter, fit_seconds, rng):
     weights = label_weights(split.styles, 300, NORMAL)
     rates = {}
     for n_sequences in (1, 100):
-        history = seed_windows(
-            split, NORMAL, candidate.history_length(), n_sequences, rng
+        history = split.seed_windows(
+            NORMAL, candidate.history_length(), n_sequences, rng
         )
-        start = time.perf_counter()
-        candidate.generate(weights, history, _draw_seed(rng))
-        rates[n_sequences] = len(weights) * n_sequences / (time.perf_counter() - start)
+        run = partial(candidate.generate, weights, history, _draw_seed(rng))
+        rates[n_sequences] = len(weights) * n_sequences / seconds(run)
     out = dict(
         seconds_per_epoch=fit_seconds / n_iter,
         training_frames_per_second=n_frames_trained * n_iter / fit_seconds,
@@ -808,18 +680,11 @@ def epoch_against_products(candidate, split, repeats=3):
         for a, b in operands:
             matmul(a, b)
 
-    timings = {}
-    for name, work in (("epoch", one_epoch), ("products", products)):
-        best = np.inf
-        for _ in range(repeats):
-            start = time.perf_counter()
-            work()
-            best = min(best, time.perf_counter() - start)
-        timings[name] = best
+    epoch, alone = seconds(one_epoch, repeats), seconds(products, repeats)
     return dict(
-        epoch_seconds=timings["epoch"],
-        products_seconds=timings["products"],
-        epoch_over_products=timings["epoch"] / timings["products"],
+        epoch_seconds=epoch,
+        products_seconds=alone,
+        epoch_over_products=epoch / alone,
         n_products=len(shapes),
     )
 
@@ -836,15 +701,13 @@ def _ratio_range(values):
     return f"{np.nanmin(values):.2f}-{np.nanmax(values):.2f}"
 
 
-def bootstrap_interval(values, rng, n_resamples=10_000):
-    """95% bootstrap interval of the mean of ``values``."""
-    values = np.asarray(values)
-    means = rng.choice(values, size=(n_resamples, len(values))).mean(axis=1)
-    return np.percentile(means, [2.5, 97.5])
+def _mean(cells, key):
+    return np.mean([cell[key] for cell in cells])
 
 
 def _kept(cells):
-    return f"{_percent([c['kept'] for c in cells])} ({_percent([c['kept_alive'] for c in cells])})"
+    kept, alive = (_percent([c[k] for c in cells]) for k in ("kept", "kept_alive"))
+    return f"{kept} ({alive})"
 
 
 def _pace(cells):
@@ -861,17 +724,13 @@ def _blends(cells):
 
 
 def _transitions(cells):
-    return f"{_percent([c['new_style'] for c in cells])} ({_percent([c['alive'] for c in cells])})"
-
-
-def _mean(cells, key):
-    return np.mean([cell[key] for cell in cells])
+    new, alive = (_percent([c[k] for c in cells]) for k in ("new_style", "alive"))
+    return f"{new} ({alive})"
 
 
 def _likelihood(cells):
-    mean, error, gap = (
-        _mean(cells, k) for k in ("mean", "standard_error", "reverse_gap")
-    )
+    keys = ("mean", "standard_error", "reverse_gap")
+    mean, error, gap = (_mean(cells, k) for k in keys)
     return f"{mean:.2f} (SE {error:.1e}, gap {gap:.1e})"
 
 
@@ -886,14 +745,8 @@ def _one_take(cells):
 
 
 def _speed(cells):
-    epoch, one, many = (
-        _mean(cells, k)
-        for k in (
-            "seconds_per_epoch",
-            "generation_fps_one",
-            "generation_fps_per_sequence_of_100",
-        )
-    )
+    epoch, one = _mean(cells, "seconds_per_epoch"), _mean(cells, "generation_fps_one")
+    many = _mean(cells, "generation_fps_per_sequence_of_100")
     text = f"{epoch:.3f} s/epoch; {one:.0f}, {many:.0f}/seq fps"
     if "epoch_over_products" in cells[0]:
         text += f"; epoch/products {_mean(cells, 'epoch_over_products'):.2f}"
@@ -916,6 +769,7 @@ COLUMNS = [
     ("one take: kept (alive); LL", "one-take", _one_take),
     ("speed: training; generation", "speed", _speed),
 ]
+FILLIN_COLUMN = "fill-in log ratio [95%]"
 
 
 def _cells(per_seed, part, seeding):
@@ -933,89 +787,69 @@ def _cells(per_seed, part, seeding):
 
 def table(results, rng):
     """One row per candidate (and seeding), its measurements over the seeds."""
-    header = ["candidate", "params", *(name for name, _, _ in COLUMNS)]
-    header.append("fill-in log ratio [95%]")
     rows = []
     for name, per_seed in results.items():
         first = next(iter(per_seed.values()))
         for k, seeding in enumerate(first.get("style") or {"": None}):
-            row = [
-                f"{name} ({seeding})" if seeding else name,
-                str(first["n_parameters"]),
-            ]
-            for _, part, formatter in COLUMNS:
+            row = {
+                "candidate": f"{name} ({seeding})" if seeding else name,
+                "params": str(first["n_parameters"]),
+            }
+            for column, part, formatter in COLUMNS:
                 cells = _cells(per_seed, part, seeding)
                 shown = cells and (part == "style" or k == 0)
-                row.append(formatter(cells) if shown else "-")
+                row[column] = formatter(cells) if shown else "-"
             ratios = _cells(per_seed, "fillin", seeding)
+            row[FILLIN_COLUMN] = "-"
             if ratios and k == 0:
-                low, high = bootstrap_interval(ratios, rng)
-                row.append(f"{np.mean(ratios):+.3f} [{low:+.3f}, {high:+.3f}]")
-            else:
-                row.append("-")
+                mean, low, high = bootstrap_mean(ratios, seed=rng)
+                row[FILLIN_COLUMN] = f"{mean:+.3f} [{low:+.3f}, {high:+.3f}]"
             rows.append(row)
-    widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
-    for row in [header, None, *rows]:
-        if row is None:
-            print("|" + "|".join("-" * (w + 2) for w in widths) + "|")
-        else:
-            print(
-                "| "
-                + " | ".join(c.ljust(w) for c, w in zip(row, widths, strict=True))
-                + " |"
-            )
+    headers = ["candidate", "params", *(c for c, _, _ in COLUMNS), FILLIN_COLUMN]
+    print_table(rows, [(header, header, "s") for header in headers])
 
 
 # ------------------------------------------------------------------- main
 def run_candidate(name, walks, split, args, seed):
     Z, styles, ids = split.frames(split.train)
     rng = np.random.default_rng(seed)
-    start = time.perf_counter()
-    candidate = CANDIDATES[name]().fit(Z, styles, ids, seed=seed, n_iter=args.n_iter)
-    fit_seconds = time.perf_counter() - start
+    candidate = CANDIDATES[name]()
+    fit = partial(candidate.fit, Z, styles, ids, seed=seed, n_iter=args.n_iter)
+    fit_seconds = seconds(fit)
     print(f"  {name}, seed {seed}: trained in {fit_seconds:.0f} s", flush=True)
+    n_iter = args.n_iter or ConditionalRBM().n_iter
+    measures = {  # in this order: they draw from one random stream
+        "style": lambda: style_kept(candidate, split, args, rng),
+        "blends": lambda: blends(candidate, split, args, rng),
+        "transitions": lambda: transitions(candidate, split, args, rng),
+        "likelihood": lambda: likelihood(candidate, split, split.test, seed),
+        "recognition": lambda: recognition(candidate, split, seed),
+        "fillin": lambda: fillin(candidate, split, seed),
+        "speed": lambda: speed(candidate, split, len(Z), n_iter, fit_seconds, rng),
+        "one-take": lambda: one_take(name, walks, args, seed, rng),
+    }
     out = {"n_parameters": int(candidate.n_parameters()), "fit_seconds": fit_seconds}
-    if "style" in args.parts:
-        out["style"] = style_kept(candidate, split, args, rng)
-    if "blends" in args.parts:
-        out["blends"] = blends(candidate, split, args, rng)
-    if "transitions" in args.parts:
-        out["transitions"] = transitions(candidate, split, args, rng)
-    if "likelihood" in args.parts:
-        out["likelihood"] = likelihood(candidate, split, split.test, seed)
-    if "recognition" in args.parts:
-        out["recognition"] = recognition(candidate, split, seed)
-    if "fillin" in args.parts:
-        out["fillin"] = fillin(candidate, split, seed)
-    if "speed" in args.parts:
-        n_iter = args.n_iter or ConditionalRBM().n_iter
-        out["speed"] = speed(candidate, split, len(Z), n_iter, fit_seconds, rng)
-    if "one-take" in args.parts:
-        out["one-take"] = one_take(name, walks, args, seed, rng)
+    for part, measure in measures.items():
+        if part in args.parts:
+            out[part] = measure()
     return out
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--data-home", default=str(REPO.parent / "shared" / "data"))
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2, 3, 4])
-    parser.add_argument(
-        "--n-iter", type=int, default=None, help="epochs (default: the package's)"
+    p = parser(__doc__)
+    p.add_argument("--n-iter", type=int, help="epochs (default: the package's)")
+    p.add_argument(
+        "--candidates", nargs="+", default=list(CANDIDATES), choices=CANDIDATES
     )
-    parser.add_argument(
-        "--candidates", nargs="+", default=list(CANDIDATES), choices=list(CANDIDATES)
-    )
-    parser.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
-    parser.add_argument("--n-frames", type=int, default=1000)
-    parser.add_argument("--n-sequences", type=int, default=6)
-    parser.add_argument(
-        "--output", default=str(REPO / "benchmarks" / "results" / "styles.json")
-    )
-    args = parser.parse_args(argv)
+    p.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
+    p.add_argument("--n-frames", type=int, default=1000)
+    p.add_argument("--n-sequences", type=int, default=6)
+    p.set_defaults(output=str(RESULTS / "styles.json"))
+    args = p.parse_args(argv)
 
     sklearn.set_config(enable_metadata_routing=True)
     walks = load_bandai_walks(args.data_home)
-    split = make_split(walks, walks.takes[walks.sequence_ids] <= 5)
+    split = Split(walks, walks.takes[walks.sequence_ids] <= 5)
     results = {}
     for name in args.candidates:
         results[name] = {
