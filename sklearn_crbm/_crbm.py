@@ -93,7 +93,10 @@ class ConditionalRBM(BaseLayerModel):
     random_state : int, RandomState instance or None, default=None
         Seeds training and, unless :meth:`sample` is given its own, generation.
     verbose : int, default=0
-        Print the epoch, reconstruction error and time every ``verbose`` epochs.
+        Every ``verbose`` epochs, print the one-step prediction error on
+        training frames beside that of repeating the previous frame (a model
+        that learns predicts better), the reconstruction error and the time;
+        with ``early_stopping``, the validation log-likelihood too.
 
     Attributes
     ----------

@@ -44,9 +44,9 @@ class FactoredCRBM(BaseStyleModel):
         One style-feature-to-factor matrix for the three kinds of factor
         (the released code's default); False learns one per kind.
     learning_rate : float, default=1e-2
-        Step size of the undirected, past-to-hidden and
-        style-feature-to-factor weights and the biases; the autoregressive
-        weights and the label-to-feature weights ``R`` take a tenth of it.
+        Step size of the undirected and style-feature-to-factor weights and
+        the biases; the directed weights (past to visible, past to hidden)
+        and the label-to-feature weights ``R`` take a tenth of it.
     momentum : float, default=0.9
         Momentum used after the first ``momentum_delay`` epochs.
     momentum_delay : int, default=5
@@ -94,7 +94,9 @@ class FactoredCRBM(BaseStyleModel):
         Controls initialisation, minibatches, sampling during training and,
         unless given their own, generation and scoring.
     verbose : int, default=0
-        Report training progress every ``verbose`` epochs.
+        Every ``verbose`` epochs, print the one-step prediction error on
+        training frames beside that of repeating the previous frame, the
+        reconstruction error and the time.
 
     Attributes
     ----------

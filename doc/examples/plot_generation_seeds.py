@@ -3,17 +3,17 @@
 Generated walks and jogs for every training seed
 ==================================================
 
-A model is only as good as its worst training seed: whether a conditional
-RBM keeps generating lively walks and jogs used to depend on the seed alone
-(a walk that freezes, a jog that shuffles in place with its legs barely
-moving).  This example trains one model per training seed with the
-defaults of :class:`~sklearn_crbm.ConditionalRBM` (200 hidden units, order 3,
-1000 epochs: ``ConditionalRBM(random_state=seed)``), lets each generate 300 frames from a walk seed and from a jog
-seed, and draws every 4th of the last 60 generated frames beside the real
-motion, one strip per seed and style, with each sequence's leg amplitude
-(RMS of the per-channel standard deviations of the hip and knee channels
-over its last 100 frames) against the real trials of its style.
-``benchmarks/generation_seeds.py`` measures the same on 12 sequences per
+A model is only as good as its worst training seed: whether a conditional RBM
+keeps generating lively walks and jogs used to depend on the seed alone (a walk
+that freezes, a jog that shuffles in place with its legs barely moving). This
+example trains one model per training seed with the defaults of
+:class:`~sklearn_crbm.ConditionalRBM` (200 hidden units, order 3, 1000 epochs:
+``ConditionalRBM(random_state=seed)``), lets each generate 300 frames from a
+walk seed and from a jog seed, and draws every 4th of the last 60 generated
+frames beside the real motion, one strip per seed and style, with each
+sequence's leg amplitude (RMS of the per-channel standard deviations of the hip
+and knee channels over its last 100 frames) against the real trials of its
+style. ``benchmarks/generation_seeds.py`` measures the same on 12 sequences per
 seed over 1000 frames.
 
 Without the CMU data the example runs on the synthetic

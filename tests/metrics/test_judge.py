@@ -46,7 +46,7 @@ def _generated(cmu, pre, Z):
 
 
 def _benchmark_judge(X, ids, expected, Z, cmu, pre, last_frames):
-    """The verdicts as benchmarks/generation_styles.py computed them."""
+    """The verdicts written from their definitions, as the old benchmark's judge."""
     names = np.asarray(pre.get_feature_names_out(), dtype=object)
     root_names = pre[:-1].get_feature_names_out()
     legs = list(names[bone_columns(names, LEGS)])
