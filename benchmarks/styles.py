@@ -74,6 +74,7 @@ import os
 for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_name, "1")
 
+import hashlib  # noqa: E402
 import itertools  # noqa: E402
 import json  # noqa: E402
 from abc import ABC, abstractmethod  # noqa: E402
@@ -83,6 +84,8 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
 from _common import (  # noqa: E402
+    CACHE,
+    PACKAGE,
     RESULTS,
     bootstrap_mean,
     frames_with_history,
@@ -835,6 +838,27 @@ def run_candidate(name, walks, split, args, seed):
     return out
 
 
+def cached_cell(name, seed, args, walks, split):
+    """``run_candidate``'s result, read from the cache when it is there.
+
+    The key is the candidate, the seed, the options that change a result and
+    the code of the package and of this script, so that runs of disjoint
+    seeds in several processes, and a rerun after a crash, share the work.
+    """
+    key = hashlib.sha1()
+    for path in sorted([*PACKAGE.rglob("*.py"), Path(__file__)]):
+        key.update(path.read_bytes())
+    options = (name, seed, args.n_iter, args.parts, args.n_frames, args.n_sequences)
+    key.update(repr(options).encode())
+    path = CACHE / "styles" / f"{name}_seed{seed}_{key.hexdigest()[:16]}.json"
+    if path.exists():
+        return json.loads(path.read_text())
+    result = run_candidate(name, walks, split, args, seed)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(result))
+    return result
+
+
 def main(argv=None):
     p = parser(__doc__)
     p.add_argument("--n-iter", type=int, help="epochs (default: the package's)")
@@ -853,7 +877,7 @@ def main(argv=None):
     results = {}
     for name in args.candidates:
         results[name] = {
-            seed: run_candidate(name, walks, split, args, seed) for seed in args.seeds
+            seed: cached_cell(name, seed, args, walks, split) for seed in args.seeds
         }
     print(
         f"\nBandai walks, 7 styles; trained on takes 001-005, judged over "

@@ -31,12 +31,12 @@ class FactoredCRBM(BaseStyleModel):
 
     Parameters
     ----------
-    n_components : int, default=300
+    n_components : int, default=600
         Number of binary hidden units.
-    n_factors : int, default=100
+    n_factors : int, default=200
         Number of factors of each kind (autoregressive, past-to-hidden,
         undirected).
-    n_style_features : int, default=50
+    n_style_features : int, default=100
         Number of real-valued style features ``z`` the labels map to.
     order : int, default=6
         Number of past frames feeding the visible and hidden units.
@@ -44,9 +44,9 @@ class FactoredCRBM(BaseStyleModel):
         One style-feature-to-factor matrix for the three kinds of factor
         (the released code's default); False learns one per kind.
     learning_rate : float, default=1e-2
-        Step size of the undirected and style-feature-to-factor weights and
-        the biases; the directed weights (past to visible, past to hidden)
-        and the label-to-feature weights ``R`` take a tenth of it.
+        Step size of the undirected weights and the biases; the directed
+        weights (past to visible, past to hidden), the style-feature-to-factor
+        weights and the label-to-feature weights ``R`` take a tenth of it.
     momentum : float, default=0.9
         Momentum used after the first ``momentum_delay`` epochs.
     momentum_delay : int, default=5
@@ -70,7 +70,7 @@ class FactoredCRBM(BaseStyleModel):
     average_fraction : float in [0, 1), default=0.0
         :meth:`fit` keeps the mean of the parameters over the last
         ``ceil(average_fraction * n_iter)`` epochs (0: the last epoch's).
-    n_iter : int, default=400
+    n_iter : int, default=200
         Number of epochs.
     n_gibbs : int, default=100
         Alternating Gibbs iterations per generated frame in :meth:`sample`.
@@ -197,10 +197,10 @@ class FactoredCRBM(BaseStyleModel):
 
     def __init__(
         self,
-        n_components=300,
+        n_components=600,
         *,
-        n_factors=100,
-        n_style_features=50,
+        n_factors=200,
+        n_style_features=100,
         order=6,
         shared_style_weights=True,
         learning_rate=1e-2,
@@ -213,7 +213,7 @@ class FactoredCRBM(BaseStyleModel):
         history_noise=1.0,
         history_noise_fraction=1.0,
         average_fraction=0.0,
-        n_iter=400,
+        n_iter=200,
         n_gibbs=100,
         priors=None,
         ais_steps=50,

@@ -32,15 +32,20 @@ __all__ = ["FactoredFrames", "FactoredLayer"]
 
 # Relative learning rates (of the estimator's ``learning_rate``) of the
 # groups that do not take the full rate: every directed group (past to
-# visible and past to hidden) and the label features.  The released code
-# takes the past-to-hidden factors at the full rate; on the Bandai walks
-# that diverges within tens of epochs.
+# visible and past to hidden), the style features' weights to the factors
+# and the label features.  The released code takes the past-to-hidden and
+# style-to-factor weights at the full rate; on the Bandai walks that
+# diverges, within tens of epochs, for some training seeds.
 RATES = {
     "past_visible_factors": 0.1,
     "visible_from_factors": 0.1,
     "past_hidden_factors": 0.1,
     "hidden_from_factors": 0.1,
     "label_features": 0.1,
+    "style_factors": 0.1,
+    "style_undirected": 0.1,
+    "style_hidden": 0.1,
+    "style_visible": 0.1,
 }
 
 

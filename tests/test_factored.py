@@ -26,7 +26,7 @@ def small_model(**params):
         order=2,
         cd_steps=1,
         learning_rate=0.1,
-        n_iter=200,
+        n_iter=400,
         n_gibbs=20,
         random_state=0,
     )
@@ -41,7 +41,7 @@ def fitted():
 
 def test_fit_learns_the_styles(fitted):
     assert_array_equal(fitted.classes_, ["high", "low"])
-    assert fitted.n_iter_ == 200 and fitted._layer.is_finite()
+    assert fitted.n_iter_ == 400 and fitted._layer.is_finite()
     X, ids, styles = styled_data(random_state=1)
     flipped = np.where(styles == "low", "high", "low")
     right = fitted.predict_next(X, styles, sequence_ids=ids)
