@@ -15,8 +15,8 @@ The model is small and trains for 200 epochs on three styles of the Bandai
 Namco walks (:func:`~sklearn_crbm.datasets.load_bandai_walks`), so that the
 example runs in well under a minute; so small and so briefly trained, it
 does not keep every style for every training seed.  The defaults of
-:class:`~sklearn_crbm.FactoredCRBM` train a larger model for 400 epochs
-(``python -m sklearn_crbm styles`` trains them on all seven styles; see
+:class:`~sklearn_crbm.FactoredCRBM` train 600 hidden units for 200 epochs:
+``python -m sklearn_crbm styles`` trains them on all seven styles (see
 :ref:`styles`).  Without the Bandai data the example runs on synthetic
 :func:`~sklearn_crbm.datasets.make_walker` motion, its walks labelled slow or
 brisk by their step frequency.
