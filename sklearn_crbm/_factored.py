@@ -51,6 +51,10 @@ class FactoredCRBM(BaseStyleModel):
         Momentum used after the first ``momentum_delay`` epochs.
     momentum_delay : int, default=5
         Number of epochs trained without momentum.
+    momentum_ramp : int, default=5
+        Number of epochs after ``momentum_delay`` over which the momentum
+        rises linearly to ``momentum`` (0: at once, as the released code);
+        the three-way weights can diverge when it starts at once.
     weight_decay : float, default=2e-4
         L2 penalty on every weight (not on biases).
     cd_steps : int, default=10
@@ -173,6 +177,7 @@ class FactoredCRBM(BaseStyleModel):
         "n_factors": [Interval(Integral, 1, None, closed="left")],
         "n_style_features": [Interval(Integral, 1, None, closed="left")],
         "shared_style_weights": ["boolean"],
+        "momentum_ramp": [Interval(Integral, 0, None, closed="left")],
         "n_gibbs": [Interval(Integral, 0, None, closed="left")],
         "learning_rate": [Interval(Real, 0, None, closed="neither")],
     }
@@ -206,6 +211,7 @@ class FactoredCRBM(BaseStyleModel):
         learning_rate=1e-2,
         momentum=0.9,
         momentum_delay=5,
+        momentum_ramp=5,
         weight_decay=2e-4,
         cd_steps=10,
         batch_size=100,
@@ -234,6 +240,7 @@ class FactoredCRBM(BaseStyleModel):
         self.learning_rate = learning_rate
         self.momentum = momentum
         self.momentum_delay = momentum_delay
+        self.momentum_ramp = momentum_ramp
         self.weight_decay = weight_decay
         self.cd_steps = cd_steps
         self.batch_size = batch_size

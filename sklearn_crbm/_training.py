@@ -45,12 +45,24 @@ class Schedule:
     batching: str
     history_noise: float
     history_noise_fraction: float
+    momentum_ramp: int = 0
 
     @classmethod
     def of(cls, estimator):
-        """The schedule an estimator's parameters of the same names give."""
+        """The schedule an estimator's parameters of the same names give
+        (those it does not have keep their defaults)."""
         params = estimator.get_params(deep=False)
-        return cls(**{name: params[name] for name in cls.__dataclass_fields__})
+        names = [name for name in cls.__dataclass_fields__ if name in params]
+        return cls(**{name: params[name] for name in names})
+
+    def momentum_at(self, epochs_done):
+        """Momentum of the epoch after ``epochs_done``: none for the first
+        ``momentum_delay`` epochs, then rising linearly to ``momentum`` over
+        ``momentum_ramp`` epochs."""
+        ramped = epochs_done - self.momentum_delay + 1
+        if ramped <= 0:
+            return 0.0
+        return self.momentum * min(1.0, ramped / (self.momentum_ramp + 1))
 
 
 class ProgressMonitor:
@@ -193,7 +205,7 @@ def train_epochs(
         # minibatches are planned with numpy; the math draws on X's device
         math_rng = array_random(rng, X)
         done = epochs_done + epoch
-        momentum = schedule.momentum if done >= schedule.momentum_delay else 0.0
+        momentum = schedule.momentum_at(done)
         squared_error = 0.0
         batches = plan_batches(frames, schedule.batch_size, rng)
         if ops is not np:  # the epoch's plan reaches the device in one copy

@@ -226,6 +226,32 @@ def test_partial_fit_and_float32(fitted):
         model.partial_fit(X, np.full(len(X), "other"), sequence_ids=ids)
 
 
+@pytest.mark.parametrize("ramp", [5, 0])
+def test_momentum_rises_over_the_ramp_after_the_delay(monkeypatch, ramp):
+    from sklearn_crbm import ConditionalRBM
+    from sklearn_crbm._parameters import MomentumUpdate
+
+    seen = []
+    apply = MomentumUpdate.apply
+
+    def recording(self, momentum, *args):
+        seen.append(momentum)
+        return apply(self, momentum, *args)
+
+    monkeypatch.setattr(MomentumUpdate, "apply", recording)
+    X, ids, styles = styled_data()
+    n_batches = -(-(len(X) - 2 * 8) // 100)  # trainable frames per minibatch
+    small_model(n_iter=12, momentum_ramp=ramp).fit(X, styles, sequence_ids=ids)
+    per_epoch = seen[::n_batches]
+    ramped = [0.15, 0.3, 0.45, 0.6, 0.75] if ramp else [0.9] * 5
+    assert_allclose(per_epoch, [0.0] * 5 + ramped + [0.9] * 2)
+    assert len(seen) == 12 * n_batches
+
+    seen.clear()  # the CRBM has no ramp: momentum starts whole
+    ConditionalRBM(n_components=4, order=2, n_iter=7).fit(X, sequence_ids=ids)
+    assert sorted(set(seen)) == [0.0, 0.9] and seen.index(0.9) == 5 * n_batches
+
+
 def test_imputer_fills_in_with_the_style_given_or_inferred(fitted):
     X_train, ids_train, styles_train = styled_data()
     X, ids, styles = styled_data(random_state=1, switching=False)
