@@ -239,6 +239,10 @@ class Candidate(ABC):
         """Seed frames that generation needs."""
         return self.model.history_length
 
+    def n_epochs(self):
+        """Epochs each of its models trained."""
+        return self.model.n_iter_
+
     def can_generate(self, weights):
         """Whether it can follow these per-frame label weights."""
         return True
@@ -305,6 +309,9 @@ class Separate(Candidate):
 
     def history_length(self):
         return max(model.history_length for model in self.models.values())
+
+    def n_epochs(self):
+        return max(model.n_iter_ for model in self.models.values())
 
     def can_generate(self, weights):
         return bool(np.all(weights.max(axis=1) == 1.0))  # one style at every frame
@@ -820,7 +827,7 @@ def run_candidate(name, walks, split, args, seed):
     fit = partial(candidate.fit, Z, styles, ids, seed=seed, n_iter=args.n_iter)
     fit_seconds = seconds(fit)
     print(f"  {name}, seed {seed}: trained in {fit_seconds:.0f} s", flush=True)
-    n_iter = args.n_iter or ConditionalRBM().n_iter
+    n_iter = candidate.n_epochs()
     measures = {  # in this order: they draw from one random stream
         "style": lambda: style_kept(candidate, split, args, rng),
         "blends": lambda: blends(candidate, split, args, rng),
