@@ -160,12 +160,6 @@ class ConditionalRBM(BaseLayerModel):
         "centering": ["boolean"],
     }
 
-    _added_parameters = {
-        "centering": False,
-        "history_noise_fraction": 1.0,
-        "average_fraction": 0.0,
-    }
-
     components_ = FittedParameter("weights")
     intercept_hidden_ = FittedParameter("hidden_bias")
     intercept_visible_ = FittedParameter("visible_bias")

@@ -133,8 +133,6 @@ class StackedCRBM(BaseCRBM):
     (90, 6)
     """
 
-    _added_parameters = {"history_noise_fraction": 1.0, "average_fraction": 0.0}
-
     # The hyper-parameters every layer takes from the stack as they are.
     _layer_parameters = (
         "order",

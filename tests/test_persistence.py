@@ -1,29 +1,48 @@
-"""Pickle and joblib round trips of every fitted estimator.
+"""Pickle and joblib round trips of every fitted estimator, and pickle formats.
 
 A loaded estimator must give exactly the transforms, predictions, samples and
 fills of the one that was saved, for the same ``random_state``, and keep
-training where it stopped.  Loading a pickle written under another
-scikit-learn version warns with ``InconsistentVersionWarning``, as
-scikit-learn's own estimators do.
+training where it stopped.  Pickles carry the package's pickle format: the
+pickle of this format stored in ``data/`` must load and compute what it
+computed when it was saved, and pickles of another format must fail with a
+ValueError that names it and says to refit -- among them real pickles of
+commit 08bf639, before the layer redesign (``data/README.md`` says how they
+were made).  Loading a pickle written under another scikit-learn version
+warns with ``InconsistentVersionWarning``, as scikit-learn's own estimators
+do.
+
+Running this file as a script writes the stored pickle of the present format
+and the outputs it must give; a change of the layout raises ``PICKLE_FORMAT``
+first (see ``sklearn_crbm/utils/_persistence.py``)::
+
+    PYTHONPATH=$PWD python tests/test_persistence.py
 """
 
 import io
 import pickle
+import sys
+import types
 import warnings
+from pathlib import Path
 
 import joblib
 import numpy as np
 import pytest
 import sklearn
 import sklearn.base
-from numpy.testing import assert_array_equal
-from sklearn.base import BaseEstimator, clone
+from numpy.testing import assert_allclose, assert_array_equal
+from sklearn.base import BaseEstimator
 from sklearn.exceptions import InconsistentVersionWarning
 from sklearn.pipeline import Pipeline
 
-from sklearn_crbm import ConditionalRBM
+from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM
 from sklearn_crbm._stacked import StackedCRBM
-from sklearn_crbm.datasets import load_cmu35, make_oscillations, make_walker
+from sklearn_crbm.datasets import (
+    load_cmu35,
+    make_oscillations,
+    make_styled_oscillations,
+    make_walker,
+)
 from sklearn_crbm.impute import CRBMImputer, NearestNeighborImputer
 from sklearn_crbm.preprocessing import (
     ExpMapEncoder,
@@ -31,12 +50,23 @@ from sklearn_crbm.preprocessing import (
     StandardScaler,
     make_motion_preprocessor,
 )
-from sklearn_crbm.utils._persistence import VersionedPickleMixin
+from sklearn_crbm.utils import _persistence
+from sklearn_crbm.utils._persistence import PICKLE_FORMAT, VersionedPickleMixin
+
+DATA = Path(__file__).parent / "data"
+STORED = DATA / f"pickle_format{PICKLE_FORMAT}.pkl"
+STORED_OUTPUTS = DATA / f"pickle_format{PICKLE_FORMAT}_outputs.npz"
 
 X_OSC, IDS_OSC = make_oscillations(n_sequences=4, n_frames=40, random_state=0)
 WALKER = make_walker(n_sequences=2, n_frames=40, random_state=0)
 X_MISSING = X_OSC[IDS_OSC == 3].copy()
 X_MISSING[20:, :2] = np.nan
+X_STY, IDS_STY, STY = make_styled_oscillations(
+    n_sequences=4, n_frames=20, random_state=0
+)
+X_STY_MISSING = X_STY[IDS_STY == 1].copy()
+X_STY_MISSING[10:, :2] = np.nan
+STYLE_MODELS = (FactoredCRBM, LabelledCRBM)
 
 
 def _pickle(estimator):
@@ -65,6 +95,31 @@ def _stack():
     )
 
 
+def _small_factored():
+    return FactoredCRBM(
+        8,
+        n_factors=4,
+        n_style_features=3,
+        order=2,
+        cd_steps=1,
+        n_iter=3,
+        n_gibbs=3,
+        random_state=0,
+    )
+
+
+def _small_labelled():
+    return LabelledCRBM(8, order=2, n_iter=3, n_gibbs=3, random_state=0)
+
+
+def _factored():
+    return _small_factored().fit(X_STY, STY, sequence_ids=IDS_STY)
+
+
+def _labelled():
+    return _small_labelled().fit(X_STY, STY, sequence_ids=IDS_STY)
+
+
 def _expmap():
     return ExpMapEncoder(WALKER.skeleton).fit(WALKER.data)
 
@@ -87,12 +142,53 @@ def _crbm_imputer():
     )
 
 
+def _style_imputer():
+    return CRBMImputer(_small_factored(), n_gibbs=3, n_particles=4, random_state=0).fit(
+        X_STY, STY, sequence_ids=IDS_STY
+    )
+
+
 def _nn_imputer():
     return NearestNeighborImputer().fit(X_OSC[IDS_OSC < 3])
 
 
+def _model_outputs(model, X, ids, styles=None):
+    """What a fitted model computes on ``X``; a style model given ``styles``.
+
+    Every method takes the styles of the frames second, as the style
+    models define them; generation takes the first and the last style.
+    """
+    given = () if styles is None else (styles,)
+    first, last = (
+        ({}, {})
+        if styles is None
+        else (
+            {"style": model.classes_[0]},
+            {"style": model.classes_[-1]},
+        )
+    )
+    outputs = [
+        model.transform(X, *given, sequence_ids=ids),
+        model.predict_next(X, *given, sequence_ids=ids),
+        model.score_samples(X, *given, sequence_ids=ids),
+        np.atleast_1d(model.score(X, *given, sequence_ids=ids)),
+        model.sample(10, n_sequences=3, random_state=0, **first),
+        model.sample(10, n_sequences=3, **last),  # the model's own random_state
+    ]
+    if styles is not None:
+        outputs.append(model.predict_proba(X, sequence_ids=ids))
+    return outputs
+
+
 def _outputs(estimator):
     """Everything a fitted estimator computes, as a list of arrays."""
+    if isinstance(estimator, CRBMImputer) and isinstance(
+        estimator.estimator_, STYLE_MODELS
+    ):
+        return [
+            estimator.transform(X_STY_MISSING, style="high"),
+            estimator.transform(X_STY_MISSING),  # the style inferred
+        ]
     if isinstance(estimator, (CRBMImputer, NearestNeighborImputer)):
         return [estimator.transform(X_MISSING)]
     if isinstance(estimator, (ExpMapEncoder, StandardScaler)):
@@ -102,16 +198,23 @@ def _outputs(estimator):
         encoded = ExpMapEncoder(WALKER.skeleton).fit_transform(WALKER.data)
         Z = estimator.transform(encoded, sequence_ids=WALKER.sequence_ids)
         return [Z, estimator.inverse_transform(Z, sequence_ids=WALKER.sequence_ids)]
-    return [
-        estimator.transform(X_OSC, sequence_ids=IDS_OSC),
-        estimator.predict_next(X_OSC, sequence_ids=IDS_OSC),
-        np.atleast_1d(estimator.score(X_OSC, sequence_ids=IDS_OSC)),
-        estimator.sample(10, n_sequences=3, random_state=0),
-        estimator.sample(10, n_sequences=3),  # the estimator's own random_state
-    ]
+    if isinstance(estimator, STYLE_MODELS):
+        return _model_outputs(estimator, X_STY, IDS_STY, STY)
+    return _model_outputs(estimator, X_OSC, IDS_OSC)
 
 
-FITTED = [_crbm, _stack, _expmap, _root, _scaler, _crbm_imputer, _nn_imputer]
+FITTED = [
+    _crbm,
+    _stack,
+    _factored,
+    _labelled,
+    _expmap,
+    _root,
+    _scaler,
+    _crbm_imputer,
+    _style_imputer,
+    _nn_imputer,
+]
 
 
 @pytest.mark.parametrize("round_trip", ROUND_TRIPS, ids=["pickle", "joblib"])
@@ -134,17 +237,30 @@ def test_crbm_imputer_draws_are_identical_after_a_round_trip():
     )
 
 
+# name -> (unfitted model, training data before sequence_ids, sequence_ids)
+PARTIAL_FITS = {
+    "crbm": (
+        lambda: ConditionalRBM(n_components=8, order=2, random_state=0),
+        (X_OSC,),
+        IDS_OSC,
+    ),
+    "factored": (_small_factored, (X_STY, STY), IDS_STY),
+    "labelled": (_small_labelled, (X_STY, STY), IDS_STY),
+}
+
+
 @pytest.mark.parametrize("round_trip", ROUND_TRIPS, ids=["pickle", "joblib"])
-def test_partial_fit_continues_identically_after_a_round_trip(round_trip):
-    model = ConditionalRBM(n_components=8, order=2, random_state=0)
-    model.partial_fit(X_OSC, sequence_ids=IDS_OSC)
+@pytest.mark.parametrize("name", list(PARTIAL_FITS))
+def test_partial_fit_continues_identically_after_a_round_trip(name, round_trip):
+    make, data, ids = PARTIAL_FITS[name]
+    model = make()
+    model.partial_fit(*data, sequence_ids=ids)
     loaded = round_trip(model)
     # The momentum, epoch count and random state travel with the model.
-    model.partial_fit(X_OSC, sequence_ids=IDS_OSC)
-    loaded.partial_fit(X_OSC, sequence_ids=IDS_OSC)
+    model.partial_fit(*data, sequence_ids=ids)
+    loaded.partial_fit(*data, sequence_ids=ids)
     assert loaded.n_iter_ == model.n_iter_ == 2
-    assert_array_equal(loaded.components_, model.components_)
-    assert_array_equal(loaded.autoregressive_, model.autoregressive_)
+    assert_array_equal(loaded._layers()[0].flat, model._layers()[0].flat)
 
 
 def test_whole_pipeline_on_cmu35_round_trips(data_home, tmp_path):
@@ -247,37 +363,134 @@ def test_whole_pipeline_under_another_version_warns_for_every_step(monkeypatch):
     }
 
 
-@pytest.mark.parametrize(
-    "make, added",
-    [
-        (
-            lambda: ConditionalRBM(5, order=2, n_iter=3, random_state=0),
-            {
-                "centering": False,
-                "history_noise_fraction": 1.0,
-                "average_fraction": 0.0,
-            },
-        ),
-        (
-            lambda: StackedCRBM((5, 4), order=2, n_iter=3, random_state=0),
-            {"history_noise_fraction": 1.0, "average_fraction": 0.0},
-        ),
-    ],
+# --------------------------------------------------------------- formats
+SMALL_OSC = make_oscillations(
+    n_sequences=2, n_frames=10, n_features=3, random_state=0
+) + (None,)
+SMALL_STY = make_styled_oscillations(
+    n_sequences=2, n_frames=10, n_features=3, random_state=0
 )
-def test_pickles_from_before_a_parameter_was_added_still_work(make, added):
-    """A pickle without a later parameter loads with the value it was trained under."""
-    X, ids = make_oscillations(n_sequences=3, n_frames=30, random_state=0)
-    model = make().fit(X, sequence_ids=ids)
-    state = model.__getstate__()
-    for name in added:
-        del state[name]  # as an earlier release wrote it
-    old = type(model).__new__(type(model))
-    old.__setstate__(state)
-    for name, value in added.items():
-        assert old.get_params()[name] == value
-    assert_array_equal(
-        old.transform(X, sequence_ids=ids), model.transform(X, sequence_ids=ids)
-    )
-    clone(old).fit(X, sequence_ids=ids)
-    if hasattr(old, "partial_fit"):
-        old.partial_fit(X, sequence_ids=ids)
+
+
+def _stored_models():
+    """name -> (the unfitted model the stored pickle holds, its data (X, ids, y))."""
+    return {
+        "crbm": (ConditionalRBM(4, order=2, n_iter=3, random_state=0), SMALL_OSC),
+        "factored": (
+            FactoredCRBM(
+                4,
+                n_factors=3,
+                n_style_features=2,
+                order=2,
+                cd_steps=1,
+                n_iter=3,
+                n_gibbs=2,
+                random_state=0,
+            ),
+            SMALL_STY,
+        ),
+        "labelled": (
+            LabelledCRBM(4, order=2, n_iter=3, n_gibbs=2, random_state=0),
+            SMALL_STY,
+        ),
+    }
+
+
+def _write_stored():
+    """Fit the stored models; write their pickle and their outputs."""
+    models, outputs = {}, {}
+    for name, (model, (X, ids, styles)) in _stored_models().items():
+        models[name] = model.fit(X, styles, sequence_ids=ids)
+        for i, output in enumerate(_model_outputs(model, X, ids, styles)):
+            outputs[f"{name}_{i}"] = output
+    STORED.write_bytes(pickle.dumps(models))
+    np.savez_compressed(STORED_OUTPUTS, **outputs)
+
+
+@pytest.fixture(scope="module")
+def stored():
+    """The stored models, loaded, and the outputs they gave when saved."""
+    models = pickle.loads(STORED.read_bytes())
+    with np.load(STORED_OUTPUTS) as outputs:
+        return models, dict(outputs)
+
+
+@pytest.mark.parametrize("name", list(_stored_models()))
+def test_stored_pickle_of_this_format_computes_what_it_computed_when_saved(
+    name, stored
+):
+    models, expected = stored
+    model = models[name]
+    unfitted, (X, ids, styles) = _stored_models()[name]
+    assert type(model) is type(unfitted)
+    # A hyper-parameter added or removed is a new layout: a new format.
+    assert model.get_params().keys() == unfitted.get_params().keys()
+    outputs = _model_outputs(model, X, ids, styles)
+    assert len(outputs) == sum(key.startswith(f"{name}_") for key in expected)
+    for i, output in enumerate(outputs):
+        assert_allclose(output, expected[f"{name}_{i}"], rtol=1e-12, atol=0)
+
+
+def _joblib_loads(payload):
+    return joblib.load(io.BytesIO(payload))
+
+
+# Real pickles of commit 08bf639 (see data/README.md): a fitted ConditionalRBM
+# of the layout before the layer redesign, and a StandardScaler, which loaded
+# as if it were new.
+OLD_PICKLES = {
+    "crbm_08bf639.pkl": r"before the layer redesign .*\(pickle format 0\): its "
+    r"fitted parameters are a sklearn_crbm\._crbm_math\.CRBMParameters, .* no "
+    r"longer reads\. Refit the model",
+    "scaler_08bf639.pkl": r"This StandardScaler was pickled by an older "
+    r"sklearn_crbm that recorded no pickle format \(format 0, .* reads pickle "
+    r"format 1 only\. Refit the StandardScaler",
+}
+
+
+@pytest.mark.parametrize("loads", [pickle.loads, _joblib_loads])
+@pytest.mark.parametrize("name", list(OLD_PICKLES))
+def test_pickles_of_an_older_layout_say_to_refit(name, loads):
+    with pytest.raises(ValueError, match=OLD_PICKLES[name]):
+        loads((DATA / name).read_bytes())
+
+
+@pytest.mark.parametrize("make", FITTED, ids=lambda f: f.__name__.strip("_"))
+def test_every_estimator_pickles_its_format(make, monkeypatch):
+    payload = pickle.dumps(make())
+    monkeypatch.setattr(_persistence, "PICKLE_FORMAT", PICKLE_FORMAT + 1)
+    with pytest.raises(
+        ValueError,
+        match=rf"pickle format {PICKLE_FORMAT}, an older layout, but sklearn_crbm "
+        rf".* reads pickle format {PICKLE_FORMAT + 1} only\. Refit the",
+    ):
+        pickle.loads(payload)
+
+
+def test_pickle_of_a_newer_format_fails_before_its_state_is_read(monkeypatch):
+    """A later format may hold classes this version lacks: the format comes first."""
+    later = types.ModuleType("sklearn_crbm_of_a_later_release")
+
+    class Layer:  # a class of the later release's fitted state
+        pass
+
+    Layer.__module__, Layer.__qualname__ = later.__name__, "Layer"
+    later.Layer = Layer
+    model = _crbm()
+    model.layer_of_a_later_release_ = Layer()
+    with monkeypatch.context() as patch:
+        patch.setitem(sys.modules, later.__name__, later)
+        patch.setattr(_persistence, "PICKLE_FORMAT", PICKLE_FORMAT + 1)
+        payload = pickle.dumps(model)
+    with pytest.raises(
+        ValueError,
+        match=rf"This ConditionalRBM was pickled by sklearn_crbm \S+ in pickle format "
+        rf"{PICKLE_FORMAT + 1}, which this version does not know: sklearn_crbm "
+        rf"\S+ reads pickle format {PICKLE_FORMAT}\.",
+    ):
+        pickle.loads(payload)
+
+
+if __name__ == "__main__":
+    _write_stored()
+    print(f"wrote {STORED} and {STORED_OUTPUTS}")

@@ -1,54 +1,149 @@
-"""Pickling that records the scikit-learn version, as scikit-learn's estimators do."""
+"""Pickles that name their layout: a format number, and the scikit-learn version.
 
+Every estimator of the package pickles through :class:`VersionedPickleMixin`,
+which writes ``PICKLE_FORMAT``, the number of the layout of the package's
+fitted state.  Loading a pickle of another format raises a ValueError that
+names the format and the package version that wrote it and says to refit,
+instead of failing deep inside pickle or, worse, loading a model that
+computes something else.  Increase ``PICKLE_FORMAT`` with every change that
+an older pickle would not survive: a fitted attribute renamed or reshaped, a
+hyper-parameter added, a class of the fitted state moved or removed.
+
+Formats:
+
+0. Before formats were recorded (up to November 2026).  Fitted models of
+   the layout before the layer redesign hold ``sklearn_crbm._crbm_math``
+   objects; that module is kept only to say so (:func:`raise_removed_layout`).
+1. The layer layout: each model's parameters in a layer object
+   (``sklearn_crbm._crbm_layer``, ``_factored_layer``, ``_labelled``).
+"""
+
+import importlib
 import warnings
+from functools import reduce
 
 import sklearn
 from sklearn.exceptions import InconsistentVersionWarning
 
-__all__ = ["VersionedPickleMixin"]
+__all__ = [
+    "PICKLE_FORMAT",
+    "VersionedPickleMixin",
+    "check_pickle_format",
+    "raise_removed_layout",
+]
+
+PICKLE_FORMAT = 1
+
+# The key of the format in an estimator's pickled state.
+_FORMAT_KEY = "_sklearn_crbm_pickle_format"
+
+
+def _package_version():
+    from .. import __version__
+
+    return __version__
+
+
+def _refit_advice(name):
+    return (
+        f"Refit the {name} with sklearn_crbm {_package_version()} and save it "
+        "again (or load it with the release that saved it)."
+    )
+
+
+def check_pickle_format(saved_format, name, saved_by="an older sklearn_crbm"):
+    """Raise a ValueError unless ``saved_format`` is the format this code reads."""
+    if saved_format == PICKLE_FORMAT:
+        return
+    reads = f"sklearn_crbm {_package_version()} reads pickle format {PICKLE_FORMAT}"
+    if saved_format is None:
+        raise ValueError(
+            f"This {name} was pickled by {saved_by} that recorded no pickle format "
+            f"(format 0, before November 2026), but {reads} only. "
+            + _refit_advice(name)
+        )
+    if isinstance(saved_format, int) and saved_format < PICKLE_FORMAT:
+        raise ValueError(
+            f"This {name} was pickled by {saved_by} in pickle format "
+            f"{saved_format}, an older layout, but {reads} only. " + _refit_advice(name)
+        )
+    raise ValueError(
+        f"This {name} was pickled by {saved_by} in pickle format {saved_format!r}, "
+        f"which this version does not know: {reads}. Load it with the release "
+        "that saved it (or a later one), or refit it with this version."
+    )
+
+
+def raise_removed_layout(module, name):
+    """Say that a pickle holds ``module.name`` of a layout no longer read."""
+    raise ValueError(
+        f"This model was pickled by an sklearn_crbm from before the layer "
+        f"redesign of November 2026 (pickle format 0): its fitted parameters are "
+        f"a {module}.{name}, a layout that sklearn_crbm {_package_version()} "
+        f"(pickle format {PICKLE_FORMAT}) no longer reads. " + _refit_advice("model")
+    )
+
+
+def _unpickle(saved_format, saved_version, module, qualname):
+    """An empty estimator to fill with its pickled state, once its format is read.
+
+    Pickle calls this before it reads the state, so a pickle of another
+    format fails here with a clear message even where its state holds
+    classes that no longer exist; the class is looked up only afterwards.
+    """
+    check_pickle_format(
+        saved_format, qualname, saved_by=f"sklearn_crbm {saved_version}"
+    )
+    cls = reduce(getattr, qualname.split("."), importlib.import_module(module))
+    return cls.__new__(cls)
 
 
 class VersionedPickleMixin:
-    """Record the scikit-learn version in pickles; warn when it differs on load.
+    """Pickle with the package's format; warn when scikit-learn's version differs.
 
-    :class:`sklearn.base.BaseEstimator` stores ``_sklearn_version`` in the
-    pickled state and warns with
-    :class:`~sklearn.exceptions.InconsistentVersionWarning` on loading under
-    another version, but only for classes defined in ``sklearn.*`` modules.
-    This mixin does the same for the estimators of this package, whose
-    fitted state (weights, scaler statistics, seed windows) may depend on
-    scikit-learn internals too.  Put it to the left of ``BaseEstimator``.
+    Loading a pickle of another format (:data:`PICKLE_FORMAT`) raises a
+    ValueError that names it and says to refit.  As
+    :class:`sklearn.base.BaseEstimator` does for ``sklearn.*`` classes only,
+    the pickle records the scikit-learn version, and loading it under
+    another warns with :class:`~sklearn.exceptions.InconsistentVersionWarning`.
+    Put the mixin to the left of ``BaseEstimator``.
 
     Examples
     --------
+    >>> import pickle
     >>> import warnings
-    >>> import sklearn
     >>> from sklearn.base import BaseEstimator
     >>> from sklearn_crbm.utils._persistence import VersionedPickleMixin
     >>> class Model(VersionedPickleMixin, BaseEstimator):
     ...     pass
     >>> state = Model().__getstate__()
-    >>> state["_sklearn_version"] == sklearn.__version__
-    True
     >>> state["_sklearn_version"] = "0.24.2"  # as if pickled by an old release
     >>> with warnings.catch_warnings(record=True) as caught:
     ...     warnings.simplefilter("always")
     ...     Model.__new__(Model).__setstate__(state)
     >>> type(caught[0].message).__name__
     'InconsistentVersionWarning'
+    >>> del state["_sklearn_crbm_pickle_format"]  # as pickled before formats
+    >>> Model.__new__(Model).__setstate__(state)
+    Traceback (most recent call last):
+    ...
+    ValueError: This Model was pickled by ... that recorded no pickle format ...
     """
 
-    # Parameters added after models were first saved, with the value under
-    # which a model pickled before them was trained: set on loading when the
-    # pickle lacks them, so get_params, clone and training keep working.
-    _added_parameters: dict = {}
+    def __reduce_ex__(self, protocol):
+        cls = type(self)
+        saved = (PICKLE_FORMAT, _package_version(), cls.__module__, cls.__qualname__)
+        return _unpickle, saved, self.__getstate__()
 
     def __getstate__(self):
         state = super().__getstate__()
-        return dict(state, _sklearn_version=sklearn.__version__)
+        return dict(
+            state, _sklearn_version=sklearn.__version__, **{_FORMAT_KEY: PICKLE_FORMAT}
+        )
 
     def __setstate__(self, state):
         state = dict(state)
+        check_pickle_format(state.pop(_FORMAT_KEY, None), type(self).__name__)
         pickled_version = state.pop("_sklearn_version", "pre-0.18")
         if pickled_version != sklearn.__version__:
             warnings.warn(
@@ -58,6 +153,4 @@ class VersionedPickleMixin:
                     original_sklearn_version=pickled_version,
                 )
             )
-        for name, value in self._added_parameters.items():
-            state.setdefault(name, value)
         super().__setstate__(state)
