@@ -420,7 +420,9 @@ def run_online(
     if observed is None:
         level = len(layers) - 1 if scheme == TOP_LAYER else 0
         for step in range(n_steps):
-            stack = history.frame_rbms(None if context is None else context[:, step])
+            stack = history.frame_rbms(
+                None if context is None else context[:, step, ...]
+            )
             start = history.previous(level)
             if start_jitter:
                 start = start + start_jitter * rng.standard_normal(

@@ -13,6 +13,8 @@ from numbers import Real
 
 import numpy as np
 from scipy.special import logsumexp
+from sklearn.base import clone
+from sklearn.utils._array_api import _estimator_with_converted_arrays
 from sklearn.utils.validation import check_is_fitted
 
 from ._base import check_count, seed_frames
@@ -534,6 +536,19 @@ n_classes), default=None
             hidden_noise=hidden_noise,
             sample_visibles=False,
         )
+
+    def __sklearn_array_api_convert__(self, converter):
+        """A copy on another namespace or device whose labels stay on the host.
+
+        :func:`sklearn.utils._array_api.move_estimator_to` would move
+        ``classes_`` too, which may hold strings no other namespace holds.
+        """
+        moved = clone(self)
+        for name, value in vars(self).items():
+            if name != "classes_":
+                value = _estimator_with_converted_arrays(value, converter)
+            setattr(moved, name, value)
+        return moved
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()

@@ -1,4 +1,4 @@
-"""ConditionalRBM under ``sklearn.set_config(array_api_dispatch=True)``.
+"""The models under ``sklearn.set_config(array_api_dispatch=True)``.
 
 Every namespace and device available here (numpy, array-api-strict on its
 two devices, PyTorch on the CPU and on CUDA when present; PyTorch only when
@@ -10,6 +10,7 @@ the same stream.
 """
 
 import importlib.util
+import itertools
 import pickle
 from functools import partial
 
@@ -30,6 +31,8 @@ from sklearn_crbm import (
     AutoregressiveImputer,
     ConditionalRBM,
     CRBMImputer,
+    FactoredCRBM,
+    LabelledCRBM,
     NearestNeighborImputer,
     StackedCRBM,
 )
@@ -105,6 +108,41 @@ def _same_place(array, reference):
     assert array_xp == xp
     assert array_device == device
     assert array.dtype == reference.dtype
+
+
+# The models of styles take every frame's style as the second argument of fit
+# and of the methods that score or transform frames, and ``style=`` in sample.
+STYLE_MODELS = {"factored": FactoredCRBM, "labelled": LabelledCRBM}
+MODELS = {"crbm": ConditionalRBM, "stack": StackedCRBM, **STYLE_MODELS}
+SMALL_STYLE_PARAMS = {
+    "factored": dict(n_factors=4, n_style_features=3, cd_steps=1, n_gibbs=3),
+    "labelled": dict(n_gibbs=3),
+}
+
+
+def _small_model(name, **params):
+    """A model of ``name`` with 6 hidden units, order 2 and 2 epochs."""
+    params = {**SMALL_STYLE_PARAMS.get(name, {}), "n_iter": 2, **params}
+    return MODELS[name](6, order=2, random_state=0, **params)
+
+
+def _styles(ids):
+    """A style for every frame: the sequences alternate between two."""
+    return np.where(ids % 2 == 1, "high", "low")
+
+
+def _is_style_model(model):
+    return isinstance(model, tuple(STYLE_MODELS.values()))
+
+
+def _given(model, ids):
+    """The frames' styles as a method's second argument; none for other models."""
+    return (_styles(ids),) if _is_style_model(model) else ()
+
+
+def _one_style(model):
+    """``style=`` for generating or filling in with a model of styles."""
+    return {"style": "high"} if _is_style_model(model) else {}
 
 
 @pytest.mark.parametrize("namespace, device_name, dtype_name", COMBINATIONS)
@@ -269,42 +307,100 @@ def test_training_and_generation_agree_with_numpy_statistically(
 
 
 @pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+@pytest.mark.parametrize("estimator", ["crbm", *STYLE_MODELS])
 def test_pickling_keeps_the_namespace_and_moving_to_numpy_keeps_the_model(
-    namespace, device_name, dtype_name, dispatch
+    namespace, device_name, dtype_name, estimator, dispatch
 ):
     xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
     X, ids = _data(dtype_name)
     X_xp = _to(xp, device, X)
-    model = ConditionalRBM(6, order=2, n_iter=2, random_state=0)
-    model.fit(X_xp, sequence_ids=ids)
-    expected = _numpy(model.transform(X_xp, sequence_ids=ids))
+    model = _small_model(estimator)
+    given = _given(model, ids)
+    model.fit(X_xp, *given, sequence_ids=ids)
+    expected = _numpy(model.transform(X_xp, *given, sequence_ids=ids))
     loaded = pickle.loads(pickle.dumps(model))
-    _same_place(loaded.components_, X_xp)
+    _same_place(loaded._layers()[0].flat, X_xp)
     np.testing.assert_array_equal(
-        _numpy(loaded.transform(X_xp, sequence_ids=ids)), expected
+        _numpy(loaded.transform(X_xp, *given, sequence_ids=ids)), expected
     )
     on_numpy = pickle.loads(pickle.dumps(move_estimator_to(model, np, None)))
     with sklearn.config_context(array_api_dispatch=False):
         np.testing.assert_allclose(
-            on_numpy.transform(X, sequence_ids=ids), expected, rtol=1e-5, atol=1e-6
+            on_numpy.transform(X, *given, sequence_ids=ids),
+            expected,
+            rtol=1e-5,
+            atol=1e-6,
         )
-        on_numpy.partial_fit(X, sequence_ids=ids)  # and trains on
-    assert isinstance(on_numpy.components_, np.ndarray)
+        on_numpy.partial_fit(X, *given, sequence_ids=ids)  # and trains on
+    assert isinstance(on_numpy._layers()[0].flat, np.ndarray)
 
 
 @pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
+@pytest.mark.parametrize("estimator", ["crbm", *STYLE_MODELS])
 def test_input_of_another_namespace_is_a_clear_error(
-    namespace, device_name, dtype_name
+    namespace, device_name, dtype_name, estimator
 ):
     xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
     X, ids = _data(dtype_name)
     with sklearn.config_context(array_api_dispatch=True):
-        model = ConditionalRBM(6, order=2, n_iter=2, random_state=0)
-        model.fit(_to(xp, device, X), sequence_ids=ids)
+        model = _small_model(estimator)
+        given = _given(model, ids)
+        model.fit(_to(xp, device, X), *given, sequence_ids=ids)
         with pytest.raises(ValueError, match="same namespace"):
-            model.transform(X, sequence_ids=ids)
+            model.transform(X, *given, sequence_ids=ids)
     with pytest.raises(ValueError, match="array_api_dispatch=True"):
-        model.score(X, sequence_ids=ids)
+        model.score(X, *given, sequence_ids=ids)
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", COMBINATIONS)
+@pytest.mark.parametrize("estimator", list(STYLE_MODELS))
+def test_style_models_fit_and_run_on_the_input_device_as_on_numpy(
+    namespace, device_name, dtype_name, estimator, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    styles = _styles(ids)
+    X_xp = _to(xp, device, X)
+    model = _small_model(estimator).fit(X_xp, styles, sequence_ids=ids)
+    model.partial_fit(X_xp, styles, sequence_ids=ids)
+    assert model.n_iter_ == 3
+    _same_place(model._layers()[0].flat, X_xp)
+    _same_place(model.seed_windows_, X_xp)
+    blend = np.full((4, 2), 0.5)  # half of each style, every frame
+    for output in (
+        model.sample(4, style="high", n_sequences=3, random_state=0),
+        model.sample(4, style=blend, history=X_xp[:2, ...], random_state=0),
+    ):
+        _same_place(output, X_xp)
+    # the likelihood's estimate is float64 in any case, as ConditionalRBM's
+    estimate = model.estimate_log_likelihood(X_xp, styles, sequence_ids=ids)
+    xp_out, _, device_out = get_namespace_and_device(estimate.log_likelihood)
+    assert (xp_out, device_out) == get_namespace_and_device(X_xp)[::2]
+    # A model fitted on numpy, moved over, computes what it computes on numpy;
+    # its labels stay a numpy array (they may be strings).
+    with sklearn.config_context(array_api_dispatch=False):
+        reference = _small_model(estimator, n_iter=5).fit(X, styles, sequence_ids=ids)
+    moved = move_estimator_to(reference, xp, device)
+    assert isinstance(moved.classes_, np.ndarray)
+    rtol = 1e-4 if dtype_name == "float32" else 1e-10
+    # style given, and unknown (each sequence's posterior, or the mixture)
+    for method, given in itertools.product(
+        ["transform", "predict_next", "score_samples"], [(styles,), ()]
+    ):
+        got = getattr(moved, method)(X_xp, *given, sequence_ids=ids)
+        _same_place(got, X_xp)
+        with sklearn.config_context(array_api_dispatch=False):
+            expected = getattr(reference, method)(X, *given, sequence_ids=ids)
+        np.testing.assert_allclose(_numpy(got), expected, rtol=rtol, atol=rtol)
+    proba = moved.predict_proba(X_xp, sequence_ids=ids)
+    _same_place(proba, X_xp)
+    with sklearn.config_context(array_api_dispatch=False):
+        expected_proba = reference.predict_proba(X, sequence_ids=ids)
+        expected_styles = reference.predict(X, sequence_ids=ids)
+    np.testing.assert_allclose(_numpy(proba), expected_proba, rtol=rtol, atol=rtol)
+    np.testing.assert_array_equal(
+        moved.predict(X_xp, sequence_ids=ids), expected_styles
+    )
 
 
 def _imputer_data(dtype_name):
@@ -623,12 +719,12 @@ def test_imputer_refuses_a_frozen_model_of_another_namespace_clearly(
 
 
 # ------------------------------------------------------- the default sizes
-# ConditionalRBM() has 200 hidden units and CRBMImputer() 20 particles per
-# draw: training minibatches, generation of many sequences and fill-in then
-# draw 4,096 or more hidden states at once, where the sampler tests float64
-# activations in float32 (issue 30: a crash on float64 data that 6 or 30
-# hidden units never reach).  Both dtypes, on a strict namespace and on
-# PyTorch; a few epochs of short sequences.
+# ConditionalRBM() has 200 hidden units (FactoredCRBM() 600) and CRBMImputer()
+# 20 particles per draw: training minibatches, generation of many sequences
+# and fill-in then draw 4,096 or more hidden states at once, where the sampler
+# tests float64 activations in float32 (issue 30: a crash on float64 data
+# that 6 or 30 hidden units never reach).  Both dtypes, on a strict namespace
+# and on PyTorch; a few epochs of short sequences.
 DEFAULT_SIZE_COMBINATIONS = [
     (namespace, device_name, dtype_name)
     for namespace, device_name in (("array_api_strict", "CPU_DEVICE"), ("torch", "cpu"))
@@ -637,10 +733,19 @@ DEFAULT_SIZE_COMBINATIONS = [
 ]
 
 
+DEFAULT_SIZES = {
+    "crbm": [200],
+    "stack": [200, 200],
+    "factored": [600],
+    "labelled": [200],
+}
+
+
 def _default_model(estimator):
-    """``ConditionalRBM()`` or ``StackedCRBM()`` at their default sizes, 2 epochs."""
-    model_class = ConditionalRBM if estimator == "crbm" else StackedCRBM
-    return model_class(n_iter=2, random_state=0)
+    """The model of ``estimator`` at its default sizes, 2 epochs."""
+    model = MODELS[estimator](n_iter=2, random_state=0)
+    assert list(np.atleast_1d(model.n_components)) == DEFAULT_SIZES[estimator]
+    return model
 
 
 def _check_outputs(outputs, shapes, reference):
@@ -653,7 +758,7 @@ def _check_outputs(outputs, shapes, reference):
 @pytest.mark.parametrize(
     "namespace, device_name, dtype_name", DEFAULT_SIZE_COMBINATIONS
 )
-@pytest.mark.parametrize("estimator", ["crbm", "stack"])
+@pytest.mark.parametrize("estimator", list(MODELS))
 def test_every_path_runs_at_the_default_size(
     namespace, device_name, dtype_name, estimator, dispatch
 ):
@@ -661,22 +766,22 @@ def test_every_path_runs_at_the_default_size(
     X, ids = _data(dtype_name)
     X_xp = _to(xp, device, X)
     model = _default_model(estimator)
-    sizes = [200] if estimator == "crbm" else [200, 200]
-    assert list(np.atleast_1d(model.n_components)) == sizes  # the defaults
-    model.fit(X_xp, sequence_ids=ids)
-    model.partial_fit(X_xp, sequence_ids=ids)
+    given, style = _given(model, ids), _one_style(model)
+    model.fit(X_xp, *given, sequence_ids=ids)
+    model.partial_fit(X_xp, *given, sequence_ids=ids)
     n_frames, n_features = X.shape
+    sizes = DEFAULT_SIZES[estimator]
     outputs = {
-        "transform": model.transform(X_xp, sequence_ids=ids),
-        "predict_next": model.predict_next(X_xp, sequence_ids=ids),
-        "score_samples": model.score_samples(X_xp, sequence_ids=ids),
-        "sample one": model.sample(4, random_state=0),
+        "transform": model.transform(X_xp, *given, sequence_ids=ids),
+        "predict_next": model.predict_next(X_xp, *given, sequence_ids=ids),
+        "score_samples": model.score_samples(X_xp, *given, sequence_ids=ids),
+        "sample one": model.sample(4, random_state=0, **style),
         # 30 sequences: 6,000 hidden states per Gibbs step
         "sample many": model.sample(
-            4, n_sequences=30, hidden_noise=1.0, random_state=0
+            4, n_sequences=30, hidden_noise=1.0, random_state=0, **style
         ),
         "sample history": model.sample(
-            4, history=X_xp[: model.history_length, ...], random_state=0
+            4, history=X_xp[: model.history_length, ...], random_state=0, **style
         ),
     }
     shapes = {
@@ -695,7 +800,7 @@ def test_every_path_runs_at_the_default_size(
         for method in ("transform", "predict_next"):
             np.testing.assert_allclose(
                 _numpy(outputs[method]),
-                getattr(on_numpy, method)(X, sequence_ids=ids),
+                getattr(on_numpy, method)(X, *given, sequence_ids=ids),
                 rtol=rtol,
                 atol=rtol,
             )
@@ -704,7 +809,7 @@ def test_every_path_runs_at_the_default_size(
 @pytest.mark.parametrize(
     "namespace, device_name, dtype_name", DEFAULT_SIZE_COMBINATIONS
 )
-@pytest.mark.parametrize("estimator", ["crbm", "stack"])
+@pytest.mark.parametrize("estimator", list(MODELS))
 def test_crbm_imputer_fills_sequences_of_different_lengths_at_the_default_size(
     namespace, device_name, dtype_name, estimator, dispatch
 ):
@@ -716,13 +821,15 @@ def test_crbm_imputer_fills_sequences_of_different_lengths_at_the_default_size(
     X_missing[12, :] = np.nan
     test_ids = np.repeat([0, 1], [12, 7])
     missing = np.isnan(X_missing)
-    imputer = CRBMImputer(_default_model(estimator), n_gibbs=3, random_state=0)
+    model = _default_model(estimator)
+    imputer = CRBMImputer(model, n_gibbs=3, random_state=0)
     assert imputer.n_particles == 20 and imputer.n_draws == 1  # the defaults
-    imputer.fit(_to(xp, device, X), sequence_ids=ids)
+    imputer.fit(_to(xp, device, X), *_given(model, ids), sequence_ids=ids)
     X_xp = _to(xp, device, X_missing)
+    # a model of styles infers the style in transform and is given it in sample
     outputs = {
         "transform": imputer.transform(X_xp, sequence_ids=test_ids),
-        "sample": imputer.sample(X_xp, 2, sequence_ids=test_ids),
+        "sample": imputer.sample(X_xp, 2, sequence_ids=test_ids, **_one_style(model)),
     }
     _check_outputs(
         outputs, {"transform": X_missing.shape, "sample": (2, *X_missing.shape)}, X_xp
