@@ -54,6 +54,15 @@ def check_label_weights(weights, n_classes, name="style"):
     return weights
 
 
+def _labels_that_compare(name):
+    """The error for labels that cannot be sorted together (str and int, None)."""
+    return TypeError(
+        f"{name} holds style labels that cannot be compared with each other or "
+        "with the styles seen in fit (such as strings and numbers mixed, or None): "
+        "give labels of one kind."
+    )
+
+
 def _on_host(labels):
     """Labels or label weights as a numpy array, from any array namespace."""
     if hasattr(labels, "__array_namespace__") and not isinstance(labels, np.ndarray):
@@ -108,14 +117,20 @@ class BaseStyleModel(BaseLayerModel):
             if labels.dtype.kind == "f" and np.any(np.isnan(labels)):
                 raise ValueError("y contains NaN: every frame needs a style label.")
             if reset:
-                self.classes_ = np.unique(labels)
+                try:
+                    self.classes_ = np.unique(labels)
+                except TypeError:
+                    raise _labels_that_compare("y") from None
             weights = self._one_hot(labels, "y")
         return self._as_context(weights, X)
 
     def _one_hot(self, labels, name):
         """Weights that put each label's whole weight on its class."""
         classes = self.classes_
-        index = np.searchsorted(classes, labels)
+        try:
+            index = np.searchsorted(classes, labels)
+        except TypeError:
+            raise _labels_that_compare(name) from None
         index = np.minimum(index, len(classes) - 1)
         unseen = classes[index] != labels
         if np.any(unseen):
@@ -207,9 +222,9 @@ class BaseStyleModel(BaseLayerModel):
             posterior[rows] = np.exp(log_post - logsumexp(log_post))
         return posterior
 
-    def _frame_log_likelihoods(self, X, sequences, y=None):
+    def _frame_log_likelihoods(self, X, sequences, y=None, name="y"):
         if y is not None:
-            context = self._as_context(self._style_weights(y, X.shape[0], "y"), X)
+            context = self._as_context(self._style_weights(y, X.shape[0], name), X)
             return self._log_likelihood(X, sequences, context=context).log_likelihood
         return self._as_context(self._mixture_log_likelihoods(X, sequences), X)
 
@@ -352,7 +367,7 @@ n_classes), default=None
         log_likelihood : ndarray of shape (n_frames,)
         """
         X, sequences = self._check_inference_input(X, sequence_ids, "score_samples")
-        log_likelihood = self._frame_log_likelihoods(X, sequences, style)
+        log_likelihood = self._frame_log_likelihoods(X, sequences, style, "style")
         return array_ops(X).astype(log_likelihood, X.dtype)
 
     @limit_blas_threads(frame_rows)

@@ -7,7 +7,7 @@ from sklearn.base import _fit_context, clone
 from sklearn.frozen import FrozenEstimator
 from sklearn.utils import check_random_state, get_tags
 from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
-from sklearn.utils.validation import check_is_fitted
+from sklearn.utils.validation import _num_samples, check_is_fitted
 
 from .._base import check_count
 from .._crbm import ConditionalRBM
@@ -222,12 +222,13 @@ class CRBMImputer(BaseMotionImputer):
             The fitted imputer.
         """
         with unfitted_on_error(self):
-            X, run_ids, rows = self._complete_frames(X, sequence_ids)
+            complete, run_ids, rows = self._complete_frames(X, sequence_ids)
+            n_frames, X = _num_samples(X), complete
             ops = array_ops(X)
             estimator = self.estimator
             if estimator is None:
                 estimator = _default_model(self.random_state)
-            styles = _complete_styles(estimator, y, rows)
+            styles = _complete_styles(estimator, y, rows, n_frames)
             if isinstance(estimator, FrozenEstimator):
                 self.estimator_ = _check_frozen(estimator.estimator, X)
             else:
@@ -437,7 +438,7 @@ n_classes), default=None
 MAX_CHANNEL_WEIGHT = 3.0
 
 
-def _complete_styles(estimator, y, rows):
+def _complete_styles(estimator, y, rows, n_frames):
     """The styles of the complete frames, for a model of styles (else None)."""
     if not get_tags(estimator).target_tags.required:
         return None
@@ -446,7 +447,13 @@ def _complete_styles(estimator, y, rows):
             f"CRBMImputer around {type(estimator).__name__} needs y in fit: the "
             "style of every training frame."
         )
-    return np.asarray(y)[rows]
+    y = np.asarray(y)
+    if y.ndim == 0 or len(y) != n_frames:
+        raise ValueError(
+            f"y must hold one style label per frame of X ({n_frames}); got an "
+            f"array of shape {y.shape}."
+        )
+    return y[rows]
 
 
 def _residual_variance(model, X, sequence_ids, styles):

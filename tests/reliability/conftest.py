@@ -12,7 +12,7 @@ import pytest
 from threadpoolctl import threadpool_limits
 
 import sklearn_crbm
-from sklearn_crbm import ConditionalRBM
+from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM
 from sklearn_crbm.datasets import make_oscillations, make_walker
 from sklearn_crbm.impute import CRBMImputer, NearestNeighborImputer
 from sklearn_crbm.preprocessing import (
@@ -33,19 +33,26 @@ N_FEATURES = 4
 ORDER = 2
 
 
+SMALL = dict(order=ORDER, n_iter=2, batch_size=20, random_state=0)
+
+
 def small_crbm(**params):
     """A ConditionalRBM that fits in milliseconds."""
-    defaults = dict(
-        n_components=5, order=ORDER, n_iter=2, batch_size=20, random_state=0
-    )
-    return ConditionalRBM(**{**defaults, **params})
+    return ConditionalRBM(**{"n_components": 5, **SMALL, **params})
 
 
 def small_stack(**params):
-    defaults = dict(
-        n_components=(5, 3), order=ORDER, n_iter=2, batch_size=20, random_state=0
-    )
-    return StackedCRBM(**{**defaults, **params})
+    return StackedCRBM(**{"n_components": (5, 3), **SMALL, **params})
+
+
+def small_factored(**params):
+    """A FactoredCRBM that fits in milliseconds: CD-1, a few factors."""
+    defaults = dict(n_components=5, n_factors=3, n_style_features=2, cd_steps=1)
+    return FactoredCRBM(**{**defaults, "n_gibbs": 3, **SMALL, **params})
+
+
+def small_labelled(**params):
+    return LabelledCRBM(**{"n_components": 5, "n_gibbs": 3, **SMALL, **params})
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -71,7 +78,13 @@ def walker():
 
 
 @pytest.fixture(scope="session")
-def fitted(oscillations, walker):
+def styles(oscillations):
+    """A style for every frame of ``oscillations``: low, high, low by sequence."""
+    return np.where(oscillations[1] % 2 == 1, "high", "low")
+
+
+@pytest.fixture(scope="session")
+def fitted(oscillations, styles, walker):
     """One fitted instance of every public estimator, keyed by a short name.
 
     Session-scoped: tests must not fit or mutate these (use
@@ -82,12 +95,17 @@ def fitted(oscillations, walker):
     return {
         "crbm": small_crbm().fit(X, sequence_ids=ids),
         "stack": small_stack().fit(X, sequence_ids=ids),
+        "factored": small_factored().fit(X, styles, sequence_ids=ids),
+        "labelled": small_labelled().fit(X, styles, sequence_ids=ids),
         "crbm_imputer": CRBMImputer(small_crbm(), n_gibbs=3, random_state=0).fit(
             X, sequence_ids=ids
         ),
         "stack_imputer": CRBMImputer(small_stack(), n_gibbs=2, random_state=0).fit(
             X, sequence_ids=ids
         ),
+        "factored_imputer": CRBMImputer(
+            small_factored(), n_gibbs=2, n_particles=4, random_state=0
+        ).fit(X, styles, sequence_ids=ids),
         "nn_imputer": NearestNeighborImputer().fit(X),
         "expmap": ExpMapEncoder(walker.skeleton).fit(walker.data),
         "root": RootRelativeEncoder(walker.skeleton).fit(Z),
@@ -99,7 +117,13 @@ def fitted(oscillations, walker):
 @pytest.fixture(scope="session")
 def factories():
     """Constructors of tiny unfitted estimators, for tests that fit their own."""
-    return {"crbm": small_crbm, "stack": small_stack, "StackedCRBM": StackedCRBM}
+    return {
+        "crbm": small_crbm,
+        "stack": small_stack,
+        "factored": small_factored,
+        "labelled": small_labelled,
+        "StackedCRBM": StackedCRBM,
+    }
 
 
 @pytest.fixture(scope="session")

@@ -6,10 +6,12 @@ before fit) and with a message that says what is wrong.  One test per case,
 so a failure names the entry point and the input.
 """
 
+import copy
 import os
 import re
 import types
 from dataclasses import dataclass
+from pathlib import Path
 
 import matplotlib
 import numpy as np
@@ -78,12 +80,13 @@ def _params(cases):
 
 
 @pytest.fixture
-def ctx(oscillations, walker, fitted, factories, real_files, tmp_path):
+def ctx(oscillations, styles, walker, fitted, factories, real_files, tmp_path):
     X, ids = oscillations
     Z = fitted["expmap"].transform(walker.data)
     return types.SimpleNamespace(
         X=X,
         ids=ids,
+        styles=styles,
         n=len(X),
         walker=walker,
         skeleton=walker.skeleton,
@@ -143,7 +146,69 @@ class Entry:
     overrides: tuple = ()  # ((kind, exception, message) or (kind, None, None))
 
 
+# The models of styles: key in the fixtures, class name; the methods that
+# take every frame's style after X (as y in score).
+STYLE_MODELS = [("factored", "FactoredCRBM"), ("labelled", "LabelledCRBM")]
+STYLE_METHODS = (
+    "transform",
+    "score_samples",
+    "predict_next",
+    "score",
+    "estimate_log_likelihood",
+)
+
+
+def _style_model_entries(key, name):
+    """A model of styles' entry points, each given every frame's style ("high")."""
+
+    def method(method_name, *args):
+        return lambda c, X: getattr(c.f[key], method_name)(X, *args)
+
+    return [
+        Entry(
+            f"{name}.fit",
+            lambda c: c.X,
+            lambda c, X: c.new[key]().fit(X, c.styles),
+            fits=True,
+        ),
+        Entry(
+            f"{name}.partial_fit",
+            lambda c: c.X,
+            lambda c, X: c.new[key]().partial_fit(X, c.styles),
+            fits=True,
+        ),
+        *[
+            Entry(f"{name}.{m}", lambda c: c.X, method(m, "high"))
+            for m in STYLE_METHODS
+        ],
+        *[
+            Entry(f"{name}.{m}", lambda c: c.X, method(m))
+            for m in ("predict", "predict_proba", "predict_log_proba")
+        ],
+    ]
+
+
 ENTRIES = [
+    *[entry for key, name in STYLE_MODELS for entry in _style_model_entries(key, name)],
+    Entry(
+        "CRBMImputer.fit(FactoredCRBM)",
+        lambda c: c.X,
+        lambda c, X: CRBMImputer(c.new["factored"]()).fit(X, c.styles),
+        allows_nan=True,
+        fits=True,
+    ),
+    Entry(
+        "CRBMImputer.transform(FactoredCRBM)",
+        lambda c: c.X,
+        lambda c, X: c.f["factored_imputer"].transform(X, style="high"),
+        allows_nan=True,
+    ),
+    Entry(
+        "CRBMImputer.sample(FactoredCRBM)",
+        lambda c: c.X,
+        lambda c, X: c.f["factored_imputer"].sample(X, 2, style="high"),
+        allows_nan=True,
+    ),
     Entry(
         "ConditionalRBM.fit",
         lambda c: c.X,
@@ -687,6 +752,38 @@ ID_ENTRIES = {
 }
 
 
+for _key, _name in STYLE_MODELS:
+    ID_ENTRIES.update(
+        {
+            f"{_name}.fit": lambda c, s, k=_key: c.new[k]().fit(
+                c.X, c.styles, sequence_ids=s
+            ),
+            f"{_name}.partial_fit": lambda c, s, k=_key: c.new[k]().partial_fit(
+                c.X, c.styles, sequence_ids=s
+            ),
+            **{
+                f"{_name}.{m}": lambda c, s, k=_key, m=m: getattr(c.f[k], m)(
+                    c.X, "high", sequence_ids=s
+                )
+                for m in STYLE_METHODS
+            },
+            f"{_name}.predict_proba": lambda c, s, k=_key: c.f[k].predict_proba(
+                c.X, sequence_ids=s
+            ),
+        }
+    )
+ID_ENTRIES.update(
+    {
+        "CRBMImputer.fit(FactoredCRBM)": lambda c, s: CRBMImputer(
+            c.new["factored"]()
+        ).fit(c.X, c.styles, sequence_ids=s),
+        "CRBMImputer.transform(FactoredCRBM)": lambda c, s: c.f[
+            "factored_imputer"
+        ].transform(c.X, sequence_ids=s),
+    }
+)
+
+
 def _routed_fit(c, s):
     X = np.tile(c.walker.data, (2, 1))[:60]
     with sklearn.config_context(enable_metadata_routing=True):
@@ -756,6 +853,28 @@ SHORT_CASES = [
         ValueError,
         "score needs frames with 4 past frames in their own sequence",
     ),
+    *[
+        case
+        for key, name in STYLE_MODELS
+        for case in (
+            Case(
+                f"{name}.fit",
+                lambda c, k=key: c.new[k]().fit(
+                    c.X, c.styles, sequence_ids=ONE_FRAME_EACH
+                ),
+                ValueError,
+                "No frame has 2 past frames in its own sequence.*lower order",
+            ),
+            Case(
+                f"{name}.score",
+                lambda c, k=key: c.f[k].score(
+                    c.X, c.styles, sequence_ids=ONE_FRAME_EACH
+                ),
+                ValueError,
+                "score needs frames with 2 past frames in their own sequence",
+            ),
+        )
+    ],
     Case(
         "CRBMImputer.fit",
         lambda c: CRBMImputer(c.new["crbm"]()).fit(c.X, sequence_ids=ONE_FRAME_EACH),
@@ -824,17 +943,28 @@ BAD_HISTORY = {
 }
 
 
+def _style_of(model):
+    """``style=`` for the sample of a model of styles; nothing for the others."""
+    return {"style": "high"} if hasattr(model, "classes_") else {}
+
+
 def _history_cases():
     cases = []
     for key, name, width in [
         ("crbm", "ConditionalRBM", 2),
         ("stack", "StackedCRBM", 4),
+        *[(key, name, 2) for key, name in STYLE_MODELS],
     ]:
         for kind, (make, exc, match) in BAD_HISTORY.items():
             n_sequences = 3 if kind == "seeds do not match n_sequences" else 1
 
             def call(c, key=key, make=make, width=width, n_sequences=n_sequences):
-                c.f[key].sample(3, history=make(width), n_sequences=n_sequences)
+                c.f[key].sample(
+                    3,
+                    history=make(width),
+                    n_sequences=n_sequences,
+                    **_style_of(c.f[key]),
+                )
 
             cases.append(
                 Case(f"{name}.sample-{kind}", call, exc, match.format(w=width))
@@ -845,6 +975,221 @@ def _history_cases():
 @pytest.mark.parametrize("case", _params(_history_cases()))
 def test_bad_history(case, ctx):
     _check(case, ctx)
+
+
+# ------------------------------------------------------------------- styles
+# kind -> (the bad styles of n frames, (exception, message) where they are the
+# y of a first fit, or None where they are valid there, (exception, message)
+# anywhere else); {name} is the argument's name, y or style.
+BAD_STYLES = {
+    "unseen label": (
+        lambda n: np.full(n, "medium"),
+        None,
+        (
+            ValueError,
+            r"{name} holds the style .*'medium'.*, not seen in fit; the styles",
+        ),
+    ),
+    "NaN label": (
+        lambda n: np.where(np.arange(n) == 5, np.nan, 1.0),
+        (ValueError, "y contains NaN: every frame needs a style label"),
+        (ValueError, "{name} contains NaN: give a style for every frame"),
+    ),
+    "strings and numbers": (
+        lambda n: np.array(["high"] * (n - 1) + [1], dtype=object),
+        (TypeError, "y holds style labels that cannot be compared"),
+        (TypeError, "{name} holds style labels that cannot be compared"),
+    ),
+    "None labels": (
+        lambda n: np.array([None] * n, dtype=object),
+        (TypeError, "y holds style labels that cannot be compared.*give labels of"),
+        (TypeError, "{name} holds style labels that cannot be compared"),
+    ),
+    "wrong length": (
+        lambda n: np.full(n - 1, "high"),
+        (ValueError, r"y must hold one style label per frame of X \(60\); got an"),
+        (ValueError, r"{name} gives 59 frames' styles but 60 are needed"),
+    ),
+    "a label too many": (
+        lambda n: np.full(n + 1, "high"),
+        (ValueError, r"y must hold one style label per frame of X \(60\); got an"),
+        (ValueError, r"{name} gives 61 frames' styles but 60 are needed"),
+    ),
+    "weights not summing to 1": (
+        lambda n: np.full((n, 2), 0.4),
+        (ValueError, "y weights must sum to 1 in every frame; a frame's sum to 0.8"),
+        (ValueError, "{name} weights must sum to 1 in every frame; a frame's sum"),
+    ),
+    "negative weights": (
+        lambda n: np.tile([-0.5, 1.5], (n, 1)),
+        (ValueError, "y weights must be non-negative"),
+        (ValueError, "{name} weights must be non-negative"),
+    ),
+    "infinite weights": (
+        lambda n: np.tile([np.inf, 0.0], (n, 1)),
+        (ValueError, "y weights contain NaN or infinity"),
+        (ValueError, "{name} weights contain NaN or infinity"),
+    ),
+    "weights of 3 styles": (
+        lambda n: np.full((n, 3), 1 / 3),
+        None,
+        (ValueError, r"{name} weights must have shape \(n_frames, 2\)"),
+    ),
+    "text weights": (
+        lambda n: np.full((n, 2), "a"),
+        (ValueError, r"y must hold one style label per frame .*shape \(60, 2\)"),
+        (TypeError, "{name} weights must be numbers"),
+    ),
+    "3-D": (
+        lambda n: np.zeros((n, 2, 1)),
+        (ValueError, r"y must hold one style label per frame .*shape \(60, 2, 1\)"),
+        (ValueError, r"{name} must be a style label, one label per frame or label"),
+    ),
+}
+
+
+def _style_calls():
+    """Every entry point taking styles: (id, call(c, styles), where, name).
+
+    ``where`` is "fit" (a first fit), "refit" (fitting a fitted model
+    further) or "use".
+    """
+    calls = []
+    for key, name in STYLE_MODELS:
+
+        def use(m, k=key):
+            return lambda c, s: getattr(c.f[k], m)(c.X, s, sequence_ids=c.ids)
+
+        calls += [
+            (
+                f"{name}.fit",
+                lambda c, s, k=key: c.new[k]().fit(c.X, s, sequence_ids=c.ids),
+                "fit",
+                "y",
+            ),
+            (
+                f"{name}.partial_fit(fitted)",
+                lambda c, s, k=key: copy.deepcopy(c.f[k]).partial_fit(
+                    c.X, s, sequence_ids=c.ids
+                ),
+                "refit",
+                "y",
+            ),
+            *[
+                (f"{name}.{m}", use(m), "use", "y" if m == "score" else "style")
+                for m in STYLE_METHODS
+            ],
+            (
+                f"{name}.sample",
+                lambda c, s, k=key: c.f[k].sample(c.n, style=s),
+                "use",
+                "style",
+            ),
+        ]
+    return calls + [
+        (
+            "CRBMImputer.fit(FactoredCRBM)",
+            lambda c, s: CRBMImputer(c.new["factored"]()).fit(
+                c.X, s, sequence_ids=c.ids
+            ),
+            "fit",
+            "y",
+        ),
+        (
+            "CRBMImputer.transform(FactoredCRBM)",
+            lambda c, s: c.f["factored_imputer"].transform(
+                _one(c.X, np.nan), style=s, sequence_ids=c.ids
+            ),
+            "use",
+            "style",
+        ),
+        (
+            "CRBMImputer.sample(FactoredCRBM)",
+            lambda c, s: c.f["factored_imputer"].sample(
+                _one(c.X, np.nan), 2, style=s, sequence_ids=c.ids
+            ),
+            "use",
+            "style",
+        ),
+    ]
+
+
+def _style_cases():
+    cases = []
+    for call_id, call, where, name in _style_calls():
+        for kind, (make, at_fit, elsewhere) in BAD_STYLES.items():
+            spec = elsewhere if where == "use" else at_fit
+            if where == "refit" and at_fit is None:
+                spec = elsewhere
+            if spec is None:  # valid styles for a first fit
+                continue
+            exc, match = spec
+            cases.append(
+                Case(
+                    f"{call_id}-{kind}",
+                    lambda c, call=call, make=make: call(c, make(c.n)),
+                    exc,
+                    match.format(name=name),
+                )
+            )
+    return cases
+
+
+OTHER_STYLE_CASES = [
+    *[
+        case
+        for key, name in STYLE_MODELS
+        for case in (
+            Case(
+                f"{name}.fit-no y",
+                lambda c, k=key: c.new[k]().fit(c.X, sequence_ids=c.ids),
+                ValueError,
+                f"{name} requires y to be passed.*give the style label of every",
+            ),
+            *[
+                Case(
+                    f"{name}(priors={priors!r}).predict_proba",
+                    lambda c, k=key, p=priors: (
+                        c.new[k](priors=p)
+                        .fit(c.X, c.styles, sequence_ids=c.ids)
+                        .predict_proba(c.X, sequence_ids=c.ids)
+                    ),
+                    ValueError,
+                    r"priors must hold one non-negative number per style \(2\)",
+                )
+                for priors in ([0.2, 0.3, 0.5], [-1.0, 2.0], [0.0, 0.0])
+            ],
+        )
+    ],
+    Case(
+        "CRBMImputer(FactoredCRBM).fit-no y",
+        lambda c: CRBMImputer(c.new["factored"]()).fit(c.X, sequence_ids=c.ids),
+        ValueError,
+        "CRBMImputer around FactoredCRBM needs y in fit",
+    ),
+    Case(
+        "CRBMImputer(ConditionalRBM).transform-a style",
+        lambda c: c.f["crbm_imputer"].transform(_one(c.X, np.nan), style="high"),
+        ValueError,
+        "ConditionalRBM has no styles: fill in without style=",
+    ),
+]
+
+
+@pytest.mark.parametrize("case", _params(_style_cases() + OTHER_STYLE_CASES))
+def test_bad_styles(case, ctx):
+    _check(case, ctx)
+
+
+@pytest.mark.parametrize("key", [key for key, _ in STYLE_MODELS])
+def test_bad_styles_leave_a_fitted_model_as_it_was(key, ctx):
+    model = copy.deepcopy(ctx.f[key])
+    before = model._layers()[0].flat.copy()
+    with pytest.raises(ValueError, match="not seen in fit"):
+        model.partial_fit(ctx.X, np.full(ctx.n, "medium"), sequence_ids=ctx.ids)
+    assert model.n_iter_ == ctx.f[key].n_iter_
+    np.testing.assert_array_equal(model._layers()[0].flat, before)
+    assert model.classes_.tolist() == ["high", "low"]
 
 
 # --------------------------------------------------------- invalid parameters
@@ -869,6 +1214,17 @@ PARAMS = [
     ("StackedCRBM", dict(n_components="big"), "'n_components' parameter"),
     ("StackedCRBM", dict(order=-1), "'order' parameter"),
     ("StackedCRBM", dict(learning_rate=-1.0), "'learning_rate' parameter"),
+    ("FactoredCRBM", dict(n_factors=0), "'n_factors' parameter"),
+    ("FactoredCRBM", dict(n_style_features=0), "'n_style_features' parameter"),
+    ("FactoredCRBM", dict(momentum_ramp=-1), "'momentum_ramp' parameter"),
+    ("FactoredCRBM", dict(shared_style_weights="yes"), "'shared_style_weights'"),
+    ("FactoredCRBM", dict(n_gibbs=-1), "'n_gibbs' parameter"),
+    ("FactoredCRBM", dict(learning_rate=np.nan), "'learning_rate' parameter"),
+    ("FactoredCRBM", dict(priors="equal"), "'priors' parameter"),
+    ("LabelledCRBM", dict(n_components=0), "'n_components' parameter"),
+    ("LabelledCRBM", dict(hidden_order=-1), "'hidden_order' parameter"),
+    ("LabelledCRBM", dict(n_gibbs=2.5), "'n_gibbs' parameter"),
+    ("LabelledCRBM", dict(batching="random"), "'batching' parameter"),
     ("CRBMImputer", dict(estimator="crbm"), "'estimator' parameter"),
     ("CRBMImputer", dict(n_gibbs=-1), "'n_gibbs' parameter"),
     ("CRBMImputer", dict(n_draws=0), "'n_draws' parameter"),
@@ -888,6 +1244,9 @@ PARAMS = [
 
 
 def _estimator(c, name, params):
+    styled = dict((name, key) for key, name in STYLE_MODELS)
+    if name in styled:
+        return c.new[styled[name]](**params)
     if name == "ConditionalRBM":
         return c.new["crbm"](**params)
     if name == "StackedCRBM":
@@ -911,7 +1270,7 @@ def _param_cases():
             Case(
                 f"{name}({label})",
                 lambda c, name=name, params=params: _estimator(c, name, params).fit(
-                    np.tile(c.X, 2)
+                    np.tile(c.X, 2), c.styles
                 ),
                 ValueError,
                 match,
@@ -936,12 +1295,16 @@ SAMPLE_PARAMS = [
 
 def _sample_cases():
     cases = []
-    for key, name in [("crbm", "ConditionalRBM"), ("stack", "StackedCRBM")]:
+    for key, name in [("crbm", "ConditionalRBM"), ("stack", "StackedCRBM")] + (
+        STYLE_MODELS
+    ):
         for params, match in SAMPLE_PARAMS:
             label = ",".join(f"{k}={v!r}" for k, v in params.items())
+            if key in dict(STYLE_MODELS):  # whose sample counts n_frames
+                match = match.replace("n_samples", "n_frames")
 
             def call(c, key=key, params=params):
-                kwargs = {"n_samples": 3, **params}
+                kwargs = {"n_samples": 3, **params, **_style_of(c.f[key])}
                 c.f[key].sample(kwargs.pop("n_samples"), **kwargs)
 
             cases.append(Case(f"{name}.sample({label})", call, ValueError, match))
@@ -1229,6 +1592,23 @@ UNFITTED = [
     ("StackedCRBM.predict_next", lambda c: c.new["stack"]().predict_next(c.X)),
     ("StackedCRBM.score", lambda c: c.new["stack"]().score(c.X)),
     ("StackedCRBM.sample", lambda c: c.new["stack"]().sample(3)),
+    *[
+        (f"{name}.{method}", lambda c, k=key, call=call: call(c.new[k](), c))
+        for key, name in STYLE_MODELS
+        for method, call in [
+            ("transform", lambda m, c: m.transform(c.X, "high")),
+            ("score_samples", lambda m, c: m.score_samples(c.X, "high")),
+            ("predict_next", lambda m, c: m.predict_next(c.X, "high")),
+            ("score", lambda m, c: m.score(c.X, c.styles)),
+            (
+                "estimate_log_likelihood",
+                lambda m, c: m.estimate_log_likelihood(c.X, "high"),
+            ),
+            ("predict", lambda m, c: m.predict(c.X)),
+            ("predict_proba", lambda m, c: m.predict_proba(c.X)),
+            ("sample", lambda m, c: m.sample(3, style="high")),
+        ]
+    ],
     ("CRBMImputer.transform", lambda c: CRBMImputer().transform(c.X)),
     ("CRBMImputer.sample", lambda c: CRBMImputer().sample(c.X)),
     (
@@ -1858,10 +2238,8 @@ def test_bad_skeletons_and_channels(case, ctx):
 
 
 # ------------------------------------------------------- a fit that failed
-def _diverging(c):
-    return c.new["crbm"](
-        n_components=8, learning_rate=50.0, momentum_delay=0, n_iter=60
-    )
+def _diverging(c, key="crbm"):
+    return c.new[key](n_components=8, learning_rate=50.0, momentum_delay=0, n_iter=60)
 
 
 def _failed(fit, use):
@@ -1915,6 +2293,39 @@ FAILED_FITS = [
         NotFittedError,
         "not fitted",
     ),
+    *[
+        case
+        for key, name in STYLE_MODELS
+        for case in (
+            Case(
+                f"{name}-short sequences, then transform",
+                _failed(
+                    _fit_fails(
+                        lambda c, k=key: c.new[k](),
+                        lambda c: c.X,
+                        lambda c: c.styles,
+                        sequence_ids=ONE_FRAME_EACH,
+                    ),
+                    lambda c, e: e.transform(c.X, "high"),
+                ),
+                NotFittedError,
+                "not fitted",
+            ),
+            Case(
+                f"{name}-diverged, then sample",
+                _failed(
+                    _fit_fails(
+                        lambda c, k=key: _diverging(c, k),
+                        lambda c: c.X * 100,
+                        lambda c: c.styles,
+                    ),
+                    lambda c, e: e.sample(3, style="high"),
+                ),
+                NotFittedError,
+                "not fitted",
+            ),
+        )
+    ],
     Case(
         "StackedCRBM-short sequences, then transform",
         _failed(
@@ -1990,6 +2401,13 @@ CLI_CASES = {
     "sample-missing model file": (
         lambda tmp: ["sample", str(tmp / "missing.joblib")],
         r"error: .*No such file or directory: .*missing\.joblib",
+    ),
+    "sample-a model pickled before the layer redesign": (
+        lambda tmp: [
+            "sample",
+            str(Path(__file__).parents[1] / "data" / "crbm_08bf639.pkl"),
+        ],
+        r"error: .*crbm_08bf639\.pkl.*before the layer redesign.*Refit the model",
     ),
     "sample-a file that is not a model": (
         lambda tmp: (
