@@ -206,6 +206,8 @@ class BaseStyleModel(BaseLayerModel):
             columns.append(to_numpy(log_likelihood).astype(np.float64))
         return np.stack(columns, axis=1)
 
+    # the posterior of a style the evidence rules out underflows to 0: exact
+    @np.errstate(under="ignore")
     def _posterior(self, X, sequences, log_likelihoods=None):
         """Each frame's sequence's posterior over the styles, (n_frames, K)."""
         if log_likelihoods is None:
@@ -228,6 +230,7 @@ class BaseStyleModel(BaseLayerModel):
             return self._log_likelihood(X, sequences, context=context).log_likelihood
         return self._as_context(self._mixture_log_likelihoods(X, sequences), X)
 
+    @np.errstate(under="ignore")
     def _mixture_log_likelihoods(self, X, sequences):
         """``log p(x_t | x_<t)`` with the style unknown: a mixture over styles.
 

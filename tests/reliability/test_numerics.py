@@ -25,36 +25,48 @@ DTYPES = [np.float32, np.float64]
 TROUBLE = dict(over="raise", invalid="raise", divide="raise")
 
 
+# The one-layer models; the models of styles take every frame's style.
+LAYER_MODELS = ["crbm", "factored", "labelled"]
+STYLE_MODELS = ["factored", "labelled"]
+
+
+def _given(key, styles):
+    """The styles of the frames as a model's second argument; none for a CRBM."""
+    return (styles,) if key in STYLE_MODELS else ()
+
+
 # --------------------------------------------------------------- divergence
-def _diverging(factories, **params):
-    return factories["crbm"](
+def _diverging(factories, key="crbm", **params):
+    return factories[key](
         n_components=8, learning_rate=50.0, momentum_delay=0, n_iter=60, **params
     )
 
 
 @pytest.mark.parametrize("dtype", DTYPES)
+@pytest.mark.parametrize("key", LAYER_MODELS)
 def test_divergence_stops_with_an_error_naming_the_learning_rate(
-    dtype, oscillations, factories
+    key, dtype, oscillations, styles, factories
 ):
     X, ids = oscillations
-    model = _diverging(factories)
+    model = _diverging(factories, key)
     with (
         np.errstate(all="ignore"),
         pytest.raises(TrainingDivergedError, match=r"learning_rate=50\.0.*Lower"),
     ):
-        model.fit((X * 100).astype(dtype), sequence_ids=ids)
+        model.fit((X * 100).astype(dtype), *_given(key, styles), sequence_ids=ids)
     assert issubclass(TrainingDivergedError, FloatingPointError)
 
 
-def test_divergence_in_partial_fit(oscillations, factories):
+@pytest.mark.parametrize("key", LAYER_MODELS)
+def test_divergence_in_partial_fit(key, oscillations, styles, factories):
     X, ids = oscillations
-    model = _diverging(factories)
+    model = _diverging(factories, key)
     with (
         np.errstate(all="ignore"),
         pytest.raises(TrainingDivergedError, match=r"learning_rate=50\.0"),
     ):
         for _ in range(60):
-            model.partial_fit(X * 100, sequence_ids=ids)
+            model.partial_fit(X * 100, *_given(key, styles), sequence_ids=ids)
 
 
 def test_binary_visibles_bound_the_updates(oscillations, factories):
@@ -133,6 +145,47 @@ def test_paper_settings_stay_finite_on_cmu35(dtype, cmu_preprocessed, factories)
     # log-likelihood per frame above that of independent standard normals
     assert np.isfinite(score) and score > -62 * (0.5 * np.log(2 * np.pi) + 0.5)
     # generated frames stay within the range of standardised data
+    assert np.abs(outputs["sample"]).max() < 20
+
+
+# The style models at sizes a user of the CMU data would start from, walks
+# and jogs labelled; few annealing steps, which the checks do not need.
+STYLE_SETTINGS = {
+    "factored": dict(n_components=200, n_factors=100, n_style_features=50, n_iter=10),
+    "labelled": dict(n_components=200, n_iter=25),
+}
+
+
+@pytest.mark.parametrize("dtype", DTYPES)
+@pytest.mark.parametrize("key", STYLE_MODELS)
+def test_style_models_stay_finite_on_cmu35(
+    key, dtype, cmu_preprocessed, data_home, factories
+):
+    Z, ids = cmu_preprocessed
+    cmu = load_cmu35(data_home, subset="all")
+    y = cmu.motion[ids]
+    assert set(y) == {"walk", "jog"}
+    X = Z.astype(dtype)
+    model = factories[key](**STYLE_SETTINGS[key], order=3, batch_size=100, ais_steps=10)
+    with np.errstate(**TROUBLE):
+        model.fit(X, y, sequence_ids=ids)
+        assert model._layers()[0].flat.dtype == dtype
+        assert np.isfinite(model._layers()[0].flat).all()
+        assert model.reconstruction_error_ < 62  # better than the mean
+        outputs = {
+            "transform": model.transform(X, y, sequence_ids=ids),
+            "score_samples": model.score_samples(X, y, sequence_ids=ids),
+            "predict_next": model.predict_next(X, y, sequence_ids=ids),
+            "predict_proba": model.predict_proba(X, sequence_ids=ids),
+            "sample": model.sample(30, style="jog", n_sequences=4, random_state=0),
+        }
+    for name, out in outputs.items():
+        assert out.dtype == dtype, name
+        assert np.isfinite(out).all(), name
+    # above independent standard normals, as for the CRBM
+    mean = outputs["score_samples"].mean()
+    assert mean > -62 * (0.5 * np.log(2 * np.pi) + 0.5)
+    np.testing.assert_allclose(outputs["predict_proba"].sum(axis=1), 1, rtol=1e-5)
     assert np.abs(outputs["sample"]).max() < 20
 
 
@@ -258,8 +311,44 @@ def test_root_encoder_is_finite_when_the_body_points_up_or_down(pitch):
     np.testing.assert_allclose(back[:, 3:6], X[:, 3:6], atol=1e-12)
 
 
+@pytest.fixture(scope="module")
+def huge_style_models(fitted):
+    """The tiny fitted style models with activations of about 1e4 or more."""
+    models = {}
+    rng = np.random.default_rng(0)
+    for key in STYLE_MODELS:
+        model = copy.deepcopy(fitted[key])
+        flat = model._layers()[0].flat
+        flat[...] = 3e3 * rng.standard_normal(flat.shape)
+        models[key] = model
+    return models
+
+
+@pytest.mark.parametrize("key", STYLE_MODELS)
+@pytest.mark.parametrize(
+    "method", ["transform", "score_samples", "predict_next", "predict_proba", "sample"]
+)
+def test_style_models_are_stable_for_huge_activations(
+    key, method, huge_style_models, oscillations, styles
+):
+    X, ids = oscillations
+    model = huge_style_models[key]
+    with np.errstate(all="raise"):
+        if method == "sample":
+            out = model.sample(5, style="low", n_sequences=2, hidden_noise=1e4)
+        elif method == "predict_proba":
+            out = model.predict_proba(X, sequence_ids=ids)
+        else:
+            out = getattr(model, method)(X, styles, sequence_ids=ids)
+    assert np.isfinite(out).all()
+    if method in ("transform", "predict_proba"):
+        assert out.min() >= 0.0 and out.max() <= 1.0
+
+
 @pytest.mark.parametrize("scale", [1.0, 1e3])
-def test_stack_and_imputers_are_stable_for_large_inputs(scale, fitted, oscillations):
+def test_stack_style_models_and_imputers_are_stable_for_large_inputs(
+    scale, fitted, oscillations
+):
     """Frames far outside the training range (1e3 standard deviations) give
     finite outputs without any floating-point warning."""
     X, ids = oscillations
@@ -274,6 +363,21 @@ def test_stack_and_imputers_are_stable_for_large_inputs(scale, fitted, oscillati
             fitted["crbm_imputer"].transform(X_missing, sequence_ids=ids),
             fitted["stack_imputer"].transform(X_missing, sequence_ids=ids),
             fitted["nn_imputer"].transform(X_missing, sequence_ids=ids),
+            fitted["factored_imputer"].transform(X_missing, sequence_ids=ids),
+            fitted["factored_imputer"].transform(
+                X_missing, sequence_ids=ids, style="high"
+            ),
+            *[
+                output
+                for key in STYLE_MODELS
+                for output in (
+                    fitted[key].transform(X, sequence_ids=ids),
+                    fitted[key].score_samples(X, sequence_ids=ids),
+                    fitted[key].predict_next(X, "low", sequence_ids=ids),
+                    fitted[key].predict_proba(X, sequence_ids=ids),
+                    fitted[key].sample(5, history=X[:6], style="high"),
+                )
+            ],
         ]
     for out in outputs:
         assert np.isfinite(out).all()
