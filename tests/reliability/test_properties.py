@@ -1,4 +1,8 @@
-"""Property-based tests: round trips, sequence handling, sampling, imputation."""
+"""Property-based tests: round trips, sequence handling, sampling, imputation.
+
+The models of styles (FactoredCRBM, LabelledCRBM) are driven through their
+own API: every frame's style as the second argument, ``style=`` in sample.
+"""
 
 import copy
 import itertools
@@ -135,10 +139,18 @@ def splits(draw, n_frames, min_length=1):
     return np.repeat(labels, lengths)
 
 
-def _per_sequence(method, X, ids, **kwargs):
-    """``method`` called on each run of ``ids`` alone, results stacked."""
+def _per_sequence(method, X, ids, *per_frame, **kwargs):
+    """``method`` called on each run of ``ids`` alone, results stacked.
+
+    ``per_frame`` arguments (such as every frame's style) are split with ``X``.
+    """
     change = np.flatnonzero(np.diff(ids)) + 1
-    parts = [method(part, **kwargs) for part in np.split(X, change)]
+    parts = [
+        method(part, *[a[rows] for a in per_frame], **kwargs)
+        for rows, part in zip(
+            np.split(np.arange(len(X)), change), np.split(X, change), strict=True
+        )
+    ]
     return np.concatenate(parts)
 
 
@@ -166,6 +178,31 @@ def test_stacked_crbm_sequences_are_independent(data, fitted, oscillations):
         method = getattr(fitted["stack"], name)
         together = method(X, sequence_ids=ids)
         assert_allclose(together, _per_sequence(method, X, ids), rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize("key", ["factored", "labelled"])
+@settings(max_examples=15, **SETTINGS)
+@given(data=st.data())
+def test_style_model_sequences_are_independent(key, data, fitted, oscillations):
+    """With every frame's style given, and unknown (each sequence's posterior)."""
+    X, _ = oscillations
+    ids = data.draw(splits(len(X)))
+    styles = np.array(
+        data.draw(
+            st.lists(st.sampled_from(["high", "low"]), min_size=len(X), max_size=len(X))
+        )
+    )
+    model = fitted[key]
+    for name in CRBM_METHODS:
+        method = getattr(model, name)
+        for style_args in ((styles,), ()):
+            together = method(X, *style_args, sequence_ids=ids)
+            alone = _per_sequence(method, X, ids, *style_args)
+            assert_allclose(together, alone, rtol=1e-10, atol=1e-12)
+    together = model.predict_proba(X, sequence_ids=ids)
+    assert_allclose(
+        together, _per_sequence(model.predict_proba, X, ids), rtol=1e-10, atol=1e-12
+    )
 
 
 @settings(max_examples=25, **SETTINGS)
@@ -252,7 +289,8 @@ def test_nearest_neighbor_imputer_sequences_are_independent(data, fitted, oscill
 
 # ---------------------------------------------------------------- sampling
 @st.composite
-def sample_requests(draw, width):
+def sample_requests(draw, width, styled=False):
+    """Arguments of ``sample``; with ``styled``, a style, a blend or a transition."""
     n_sequences = draw(st.integers(1, 3))
     kind = draw(st.sampled_from(["none", "2-D", "3-D"]))
     history = None
@@ -261,22 +299,31 @@ def sample_requests(draw, width):
         shape = (n_frames, 4) if kind == "2-D" else (n_sequences, n_frames, 4)
         seed = draw(st.integers(0, 2**16))
         history = np.random.default_rng(seed).standard_normal(shape)
+    n_samples = draw(st.integers(1, 6))
+    style = {}
+    if styled:
+        high = draw(st.lists(st.floats(0, 1), min_size=n_samples, max_size=n_samples))
+        weights = np.column_stack([high, 1 - np.array(high)])
+        style["style"] = draw(st.sampled_from(["high", "low", weights]))
     return dict(
-        n_samples=draw(st.integers(1, 6)),
+        n_samples=n_samples,
         n_sequences=n_sequences,
         history=history,
         n_gibbs=draw(st.integers(0, 3)),
         hidden_noise=draw(st.sampled_from([0.0, 0.5])),
         random_state=draw(st.integers(0, 2**31 - 1)),
+        **style,
     )
 
 
-@pytest.mark.parametrize("key, width", [("crbm", 2), ("stack", 4)])
+@pytest.mark.parametrize(
+    "key, width", [("crbm", 2), ("stack", 4), ("factored", 2), ("labelled", 2)]
+)
 @settings(max_examples=20, **SETTINGS)
 @given(data=st.data())
 def test_sample_shape_dtype_and_determinism(key, width, data, fitted):
     model = fitted[key]
-    request = data.draw(sample_requests(width))
+    request = data.draw(sample_requests(width, styled=hasattr(model, "classes_")))
     kwargs = dict(request)
     n_samples = kwargs.pop("n_samples")
     first = model.sample(n_samples, **kwargs)
@@ -351,7 +398,7 @@ def test_nearest_neighbor_imputer_with_a_numeric_marker(data, oscillations):
     assert not (filled == -999.0).any()
 
 
-@pytest.mark.parametrize("key", ["crbm_imputer", "stack_imputer"])
+@pytest.mark.parametrize("key", ["crbm_imputer", "stack_imputer", "factored_imputer"])
 @settings(max_examples=15, **SETTINGS)
 @given(data=st.data(), n_draws=st.integers(1, 2))
 def test_crbm_imputer_keeps_observed_and_fills_all(
@@ -361,13 +408,18 @@ def test_crbm_imputer_keeps_observed_and_fills_all(
     mask = data.draw(missing_masks(X.shape))
     ids = data.draw(splits(len(X)))
     imputer = copy.deepcopy(fitted[key]).set_params(n_draws=n_draws)
+    # a model of styles fills in given the style, or inferring it
+    style = {}
+    if key == "factored_imputer":
+        style["style"] = data.draw(st.sampled_from(["high", "low", None]))
     X_missing = np.where(mask, np.nan, X)
     original = X_missing.copy()
-    filled = imputer.transform(X_missing, sequence_ids=ids)
+    filled = imputer.transform(X_missing, sequence_ids=ids, **style)
     _check_fill(X_missing, filled, mask)
     assert_array_equal(X_missing, original)  # the input is not modified
     # and a repeated call with the same random_state fills identically
-    assert_array_equal(imputer.transform(X_missing, sequence_ids=ids), filled)
+    again = imputer.transform(X_missing, sequence_ids=ids, **style)
+    assert_array_equal(again, filled)
 
 
 @settings(max_examples=10, **SETTINGS)
@@ -383,12 +435,16 @@ def test_crbm_imputer_samples_keep_observed_values(data, fitted, oscillations):
         _check_fill(X_missing, fill, mask)
 
 
+@pytest.mark.parametrize("key", ["crbm", "factored", "labelled"])
 @settings(max_examples=10, **SETTINGS)
 @given(data=st.data())
-def test_only_the_runs_of_sequence_ids_matter(data, factories, oscillations):
+def test_only_the_runs_of_sequence_ids_matter(
+    key, data, factories, oscillations, styles
+):
     """Relabelling the runs (any distinct integers, or whole floats) trains the
     same model."""
     X, ids = oscillations
+    style_args = () if key == "crbm" else (styles,)
     change = np.flatnonzero(np.diff(ids)) + 1
     lengths = np.diff([0, *change, len(ids)])
     labels = data.draw(
@@ -396,11 +452,10 @@ def test_only_the_runs_of_sequence_ids_matter(data, factories, oscillations):
     )
     relabelled = np.repeat(labels, lengths)
     as_floats = relabelled.astype(np.float64)  # exact: |labels| < 2**53
-    reference = factories["crbm"]().fit(X, sequence_ids=ids)
+    reference = factories[key]().fit(X, *style_args, sequence_ids=ids)
     for other_ids in (relabelled, as_floats):
-        model = factories["crbm"]().fit(X, sequence_ids=other_ids)
-        assert_array_equal(model.components_, reference.components_)
-        assert_array_equal(model.autoregressive_, reference.autoregressive_)
+        model = factories[key]().fit(X, *style_args, sequence_ids=other_ids)
+        assert_array_equal(model._layers()[0].flat, reference._layers()[0].flat)
 
 
 @settings(max_examples=25, **SETTINGS)

@@ -71,6 +71,24 @@ CALLS = {
     "StackedCRBM.sample": lambda f, X, ids, k: f["stack"].sample(
         10, n_sequences=2, random_state=k
     ),
+    "FactoredCRBM.transform": lambda f, X, ids, k: f["factored"].transform(
+        X, "high", sequence_ids=ids
+    ),
+    "FactoredCRBM.predict_proba": lambda f, X, ids, k: f["factored"].predict_proba(
+        X, sequence_ids=ids
+    ),
+    "FactoredCRBM.sample": lambda f, X, ids, k: f["factored"].sample(
+        10, style="low", n_sequences=2, random_state=k
+    ),
+    "LabelledCRBM.score_samples": lambda f, X, ids, k: f["labelled"].score_samples(
+        X, sequence_ids=ids
+    ),
+    "LabelledCRBM.sample(history)": lambda f, X, ids, k: f["labelled"].sample(
+        10, history=X[:5], style="high", n_sequences=2, random_state=k
+    ),
+    "CRBMImputer(FactoredCRBM).sample": lambda f, X, ids, k: f[
+        "factored_imputer"
+    ].sample(_erase(X, k), 2, sequence_ids=ids, random_state=k),
     "CRBMImputer.sample": lambda f, X, ids, k: f["crbm_imputer"].sample(
         _erase(X, k), 2, sequence_ids=ids, random_state=k
     ),
