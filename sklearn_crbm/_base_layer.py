@@ -17,7 +17,11 @@ from ._training import ProgressMonitor, Schedule, train_epochs
 from .utils._array_api import array_ops
 from .utils._fitting import unfitted_on_error
 from .utils._random import rng_from
-from .utils._sequences import check_sequence_ids, validation_split
+from .utils._sequences import (
+    check_sequence_ids,
+    validation_split,
+    warn_if_sequences_unmarked,
+)
 from .utils._threads import batch_rows, limit_blas_threads
 
 __all__ = ["BaseLayerModel"]
@@ -91,6 +95,7 @@ class BaseLayerModel(BaseCRBM):
         self : object
             The fitted model.
         """
+        warn_if_sequences_unmarked(X, sequence_ids, f"{type(self).__name__}.fit")
         with unfitted_on_error(self):
             xp, _ = get_namespace_and_device(X)[:2]
             X = validate_data(self, X, dtype=[xp.float64, xp.float32], reset=True)

@@ -7,6 +7,7 @@ library.
 """
 
 import argparse
+import re
 import shutil
 import sys
 from pathlib import Path
@@ -16,9 +17,10 @@ import numpy as np
 import sklearn
 from sklearn.utils import Bunch
 
-from ._cli_options import COMMANDS
+from ._cli_options import COMMANDS, MAX_DEFAULT_RATE
 from ._crbm import ConditionalRBM
 from ._demo import run_demo as _run_demo
+from ._demo import save_gif
 from ._factored import FactoredCRBM
 from ._style_demo import run_styles as _run_styles
 from .datasets import (
@@ -30,6 +32,7 @@ from .datasets import (
     load_cmu35,
     read_amc_folder,
     read_bvh_folder,
+    resample_frames,
 )
 from .preprocessing import MotionPipeline, make_motion_pipeline
 
@@ -49,7 +52,7 @@ def main(argv=None):
     try:
         with sklearn.config_context(enable_metadata_routing=True):
             return args.run(args)
-    except (OSError, ValueError) as exc:
+    except (ImportError, OSError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
 
@@ -145,7 +148,9 @@ def run_fit(args):
     print(
         f"training on {len(data.data)} frames of {n} sequence{'s' * (n != 1)} "
         f"at {data.frame_rate:g} frames/s"
+        + (f", labels {', '.join(dict.fromkeys(styles))}" if args.labels else "")
     )
+    _check_order(args.order, data)
     pipeline = make_motion_pipeline(data.skeleton, _model_from_args(args))
     pipeline.fit(data.data, sequence_ids=data.sequence_ids)
     windows = {}
@@ -166,18 +171,93 @@ def run_fit(args):
 def _training_data(args):
     """The training motion, and each frame's style where it is known."""
     if args.folder is None:
+        if args.labels is not None:
+            raise ValueError(
+                "--labels labels the files of a folder: give the folder too."
+            )
         train = _load_cmu35(args.data_home, "train")
         return train, np.asarray(train.motion, dtype=object)[train.sequence_ids]
-    if not args.folder.is_dir():
-        raise FileNotFoundError(f"{args.folder} is not a folder.")
-    if any(args.folder.glob("*.bvh")):
-        return read_bvh_folder(args.folder, frame_rate=args.frame_rate), None
-    if any(args.folder.glob("*.amc")):
-        return read_amc_folder(args.folder, frame_rate=args.frame_rate), None
-    raise FileNotFoundError(
-        f"{args.folder} holds no *.bvh or *.amc file: fit reads a folder of BVH "
-        "files, or of AMC files with their ASF skeleton."
-    )
+    data = _read_motion_folder(args.folder, args.frame_rate, args.labels)
+    if args.labels is None:
+        return data, None
+    return data, data.target_names[data.target]
+
+
+def _read_motion_folder(folder, frame_rate=None, labels=None):
+    """A folder of BVH files, or of AMC files with their ASF skeleton.
+
+    ``frame_rate`` None: the files' own rate, brought down to
+    ``MAX_DEFAULT_RATE`` when faster.  ``labels``: see ``fit --labels``; the
+    label names are text, as typed after ``--style`` (also labels that are
+    numbers).
+    """
+    if not folder.is_dir():
+        raise FileNotFoundError(f"{folder} is not a folder.")
+    if any(folder.glob("*.bvh")):
+        read = read_bvh_folder
+    elif any(folder.glob("*.amc")):
+        read = read_amc_folder
+    else:
+        raise FileNotFoundError(
+            f"{folder} holds no *.bvh or *.amc file: the command reads a folder "
+            "of BVH files, or of AMC files with their ASF skeleton."
+        )
+    labels = _label_source(labels)
+    try:
+        data = read(folder, frame_rate=frame_rate, labels=labels)
+    except ValueError as exc:
+        if "by dropping frames" not in str(exc):  # not about the frame rates
+            raise
+        given = "" if frame_rate is None else f"--frame-rate {frame_rate:g}: "
+        raise ValueError(
+            f"{given}{exc} On the command line, --frame-rate sets the rate to "
+            "train at: at most the slowest file's (leave it out to train at the "
+            "files' own rate)."
+        ) from None
+    if frame_rate is None and data.frame_rate > MAX_DEFAULT_RATE:
+        keep = resample_frames(
+            np.arange(len(data.data)),
+            frame_rate=data.frame_rate,
+            target_rate=MAX_DEFAULT_RATE,
+            sequence_ids=data.sequence_ids,
+        )
+        for key in ("data", "sequence_ids", "target"):
+            if key in data:
+                data[key] = data[key][keep]
+        data.frame_rate = MAX_DEFAULT_RATE
+    if labels is not None:
+        data.target_names = np.array([str(name) for name in data.target_names])
+    return data
+
+
+def _label_source(labels):
+    """``--labels`` as the folder readers take it: a pattern with a group, or a key."""
+    if labels is None or "(" not in labels:
+        return labels
+    try:
+        pattern = re.compile(labels)
+    except re.error as exc:
+        raise ValueError(
+            f"--labels {labels!r} is not a regular expression: {exc}."
+        ) from None
+    if pattern.groups != 1:
+        raise ValueError(
+            f"--labels {labels!r} must have one group, the label: e.g. "
+            "'walk_([a-z]+)_'."
+        )
+    return pattern
+
+
+def _check_order(order, data):
+    """Say in the command's terms when no training sequence is long enough."""
+    longest = int(np.bincount(data.sequence_ids).max())
+    if longest <= order:
+        raise ValueError(
+            f"--order {order} needs sequences of more than {order} frames, but "
+            f"the longest training sequence has {longest} frames at "
+            f"{data.frame_rate:g} frames/s: lower --order, or train on longer "
+            "(or faster, with --frame-rate) takes."
+        )
 
 
 def _load_model(path):
@@ -213,12 +293,21 @@ def run_sample(args):
         random_state=args.seed,
     )
     suffixes = [".bvh"] + [".amc"] * (pipeline.skeleton.convention == "acclaim")
-    for k in range(args.n_sequences):
-        sequence = raw[k * args.n_frames : (k + 1) * args.n_frames]
+    sequences = np.split(raw, args.n_sequences)
+    for k, sequence in enumerate(sequences):
         for suffix in suffixes:
             path = Path(f"{args.output}_{k}{suffix}")
             pipeline.write_motion(path, sequence, frame_rate=saved.frame_rate)
             print(f"wrote {path}")
+    if args.animate:
+        path = save_gif(
+            Path(f"{args.output}.gif"),
+            pipeline.skeleton,
+            sequences,
+            titles=[f"{args.output.name}_{k}" for k in range(len(sequences))],
+            frame_rate=saved.frame_rate,
+        )
+        print(f"wrote {path}")
     return 0
 
 
@@ -239,12 +328,17 @@ def _seeds(saved, args):
 
 
 def run_styles(args):
-    walks = _load(
-        load_bandai_walks,
-        args.data_home,
-        "The Bandai Namco walks are",
-        " --dataset bandai",
-    )
+    if args.folder is not None:
+        walks = _read_motion_folder(args.folder, args.frame_rate, args.labels)
+        walks.name = f"the motion in {args.folder}"
+    else:
+        walks = _load(
+            load_bandai_walks,
+            args.data_home,
+            "The Bandai Namco walks are",
+            " --dataset bandai",
+        )
+        walks.name = "Bandai Namco walks"
     model = FactoredCRBM(
         args.n_components,
         n_factors=args.n_factors,
@@ -255,6 +349,7 @@ def run_styles(args):
         random_state=args.seed,
         verbose=max(1, args.n_iter // 10),
     )
+    _check_order(args.order, walks)
     return _run_styles(args, walks, model)
 
 

@@ -1,5 +1,7 @@
 """The command line's commands and their arguments (see :mod:`._cli`)."""
 
+import argparse
+import math
 import tempfile
 from pathlib import Path
 
@@ -22,20 +24,67 @@ def _option(*flags, help, **settings):
     return flags, dict(help=help, **settings)
 
 
+def _checked(convert, kind, accept, bound):
+    """An argparse type: ``convert(text)``, which ``accept`` must hold for.
+
+    argparse names the flag in the errors, e.g. "argument --n-iter: must be
+    at least 1, got 0".
+    """
+
+    def parse(text):
+        try:
+            value = convert(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be {kind}, got {text!r}") from None
+        if not accept(value):
+            raise argparse.ArgumentTypeError(f"must be {bound}, got {text}")
+        return value
+
+    return parse
+
+
+def _count(minimum):
+    """An argparse type: a whole number of at least ``minimum``."""
+    return _checked(
+        int, "a whole number", lambda n: n >= minimum, f"at least {minimum}"
+    )
+
+
+_rate = _checked(
+    float, "a number of frames per second", lambda r: 0 < r < math.inf, "positive"
+)
+
+
+# A folder's motion is trained at its files' own rate, but at most this many
+# frames per second (the paper's 30; CMU's AMC files are 120).
+MAX_DEFAULT_RATE = 30.0
+
+
 _DATA_HOME = _option(
     "--data-home",
     type=Path,
     help="data folder (default: $SKLEARN_CRBM_DATA, else ~/sklearn_crbm_data)",
 )
 _N_FRAMES = _option(
-    "--n-frames", type=int, default=300, help="frames generated per sequence"
+    "--n-frames", type=_count(1), default=300, help="frames generated per sequence"
 )
 _SEED = _option(
     "--seed", type=int, default=0, help="random seed of training and sampling"
 )
+_FRAME_RATE = _option(
+    "--frame-rate",
+    type=_rate,
+    help="frames per second to train at; faster files drop frames (default: "
+    f"the files' own rate, at most {MAX_DEFAULT_RATE:g}; AMC files are read as "
+    "120 frames/s, CMU's rate)",
+)
 _MODEL_OPTIONS = [
-    _option("--n-components", type=int, default=200, help="hidden units of the CRBM"),
-    _option("--order", type=int, default=3, help="past frames each frame depends on"),
+    _option(
+        "--n-components", type=_count(1), default=200, help="hidden units of the CRBM"
+    ),
+    _option(
+        "--order", type=_count(0), default=3, help="past frames each frame depends on"
+    ),
     _option(
         "--history-noise",
         type=float,
@@ -57,44 +106,47 @@ _MODEL_OPTIONS = [
         "the last epoch's, the paper's schedule)",
     ),
     _option(
-        "--n-iter", type=int, default=1000, help="training epochs (the paper: 4000)"
+        "--n-iter",
+        type=_count(1),
+        default=1000,
+        help="training epochs (the paper: 4000)",
     ),
     _SEED,
 ]
 _FACTORED_OPTIONS = [
     _option(
         "--n-components",
-        type=int,
+        type=_count(1),
         default=_FACTORED.n_components,
         help="hidden units of the factored CRBM",
     ),
     _option(
         "--n-factors",
-        type=int,
+        type=_count(1),
         default=_FACTORED.n_factors,
         help="factors of each kind (autoregressive, past-to-hidden, undirected)",
     ),
     _option(
         "--n-style-features",
-        type=int,
+        type=_count(1),
         default=_FACTORED.n_style_features,
         help="real-valued style features the labels map to",
     ),
     _option(
         "--order",
-        type=int,
+        type=_count(0),
         default=_FACTORED.order,
         help="past frames each frame depends on",
     ),
     _option(
         "--n-iter",
-        type=int,
+        type=_count(1),
         default=_FACTORED.n_iter,
         help="training epochs (the released code: 200)",
     ),
     _option(
         "--n-gibbs",
-        type=int,
+        type=_count(0),
         default=_FACTORED.n_gibbs,
         help="Gibbs iterations per generated frame",
     ),
@@ -107,7 +159,8 @@ COMMANDS = {
         "the paper's demo on CMU 35: train, fill in, generate, draw",
         "Train a CRBM on CMU subject 35, print the fill-in table against "
         "nearest neighbour, KNNImputer and the autoregressive imputer, "
-        "generate walking and jogging, and write figures and BVH/AMC files. "
+        "generate walking and jogging, and write figures, BVH/AMC files and a "
+        "GIF of real and generated motion moving side by side. "
         "The defaults take a few minutes on 2 cores; --full runs the paper's "
         "4000 epochs and 100 fill-in repeats.",
         [
@@ -122,13 +175,13 @@ COMMANDS = {
             ),
             _option(
                 "--n-repeats",
-                type=int,
+                type=_count(1),
                 default=20,
                 help="single-draw fills averaged per case (the paper: 100)",
             ),
             _option(
                 "--n-particles",
-                type=int,
+                type=_count(1),
                 default=20,
                 help="weighted particles per fill-in chain (1: the original scheme)",
             ),
@@ -141,7 +194,8 @@ COMMANDS = {
             _option(
                 "--no-figures",
                 action="store_true",
-                help="skip the figures (the BVH and AMC files are still written)",
+                help="skip the figures and GIFs (the BVH and AMC files are still "
+                "written)",
             ),
         ],
     ),
@@ -170,7 +224,8 @@ COMMANDS = {
         "skeleton), or on CMU subject 35 when no folder is given, and save "
         "them with joblib for the sample command. The file holds a dict: "
         "'pipeline' (a fitted sklearn_crbm.preprocessing.MotionPipeline), "
-        "'seed_windows' (real frames of each style, CMU 35 only) and "
+        "'seed_windows' (real frames of each style: CMU 35's walk and jog, "
+        "or the labels of --labels) and "
         "'frame_rate'.",
         [
             _option(
@@ -181,12 +236,15 @@ COMMANDS = {
                 "(default: CMU subject 35's training trials from --data-home)",
             ),
             _DATA_HOME,
+            _FRAME_RATE,
             _option(
-                "--frame-rate",
-                type=float,
-                default=30.0,
-                help="frames per second to train at; faster files drop frames "
-                "(AMC files are read as 120 frames/s, CMU's rate)",
+                "--labels",
+                help="label every file, and keep seed frames of each label for "
+                "'sample --style': a key of the JSON file beside each motion "
+                "file ('style' reads walk_001.json's {\"style\": 2}, named by "
+                "style_label.txt when there is one), or a regular expression "
+                "with a group, matched against each file's name "
+                "('walk_([a-z]+)_' labels walk_proud_01.bvh 'proud')",
             ),
             *_MODEL_OPTIONS,
             _option(
@@ -212,7 +270,9 @@ COMMANDS = {
                 "from every training sequence",
             ),
             _N_FRAMES,
-            _option("--n-sequences", type=int, default=1, help="sequences generated"),
+            _option(
+                "--n-sequences", type=_count(1), default=1, help="sequences generated"
+            ),
             _option(
                 "--hidden-noise",
                 type=float,
@@ -233,16 +293,25 @@ COMMANDS = {
                 default=Path("generated"),
                 help="prefix of the files written (PREFIX_0.bvh, PREFIX_1.bvh, ...)",
             ),
+            _option(
+                "--animate",
+                action="store_true",
+                help="also write PREFIX.gif: the generated sequences moving side "
+                "by side (needs matplotlib and pillow)",
+            ),
         ],
     ),
     "styles": (
         "many styles from one factored CRBM: BVH files, strips, a judge",
         "Train a FactoredCRBM (Taylor & Hinton, ICML 2009) on the Bandai "
-        "Namco walks in seven styles, generate a walk in every style, a "
+        "Namco walks in seven styles (or on a labelled folder of your own, "
+        "--folder and --labels), generate a walk in every style, a "
         "50/50 blend of two styles and a transition from one style to "
         "another half-way, all seeded with real frames of a normal walk, "
-        "and write them as BVH files with a skeleton strip of each and a "
-        "plot of the style judge's probabilities over the transition. "
+        "and write them as BVH files with a skeleton strip of each, a "
+        "plot of the style judge's probabilities over the transition, and "
+        "GIFs of every style moving side by side and of the transition over "
+        "the judge's probabilities. "
         "Prints a table of how a StyleJudge trained on the real takes sees "
         "every style: the share of 2-s windows judged as the style asked "
         "for, and the leg amplitude and step frequency against the real "
@@ -250,6 +319,20 @@ COMMANDS = {
         "first with 'fetch --dataset bandai'.",
         [
             _DATA_HOME,
+            _option(
+                "--folder",
+                type=Path,
+                help="train on this labelled folder of BVH files instead of the "
+                "Bandai walks (labels from --labels)",
+            ),
+            _option(
+                "--labels",
+                default="style",
+                help="with --folder: where each file's style comes from, as for "
+                "'fit --labels' (a JSON key, or a regular expression with a "
+                "group matched against the file names)",
+            ),
+            _FRAME_RATE,
             *_FACTORED_OPTIONS,
             _option(
                 "--output",
@@ -259,40 +342,40 @@ COMMANDS = {
             ),
             _option(
                 "--n-frames",
-                type=int,
+                type=_count(1),
                 default=600,
                 help="frames generated per sequence (at least 120)",
             ),
             _option(
                 "--n-sequences",
-                type=int,
+                type=_count(1),
                 default=3,
                 help="sequences generated per style, blend and transition: the "
                 "table judges them all, the first is written",
             ),
             _option(
                 "--seed-style",
-                default="normal",
-                help="every sequence starts from real frames of this style",
+                help="every sequence starts from real frames of this style "
+                "(default: normal, or the first style of a folder without it)",
             ),
             _option(
                 "--blend",
                 nargs=2,
                 metavar="STYLE",
-                default=["elderly", "youthful"],
-                help="the two styles blended 50/50",
+                help="the two styles blended 50/50 (default: elderly youthful, "
+                "or a folder's first two styles)",
             ),
             _option(
                 "--transition",
                 nargs=2,
                 metavar="STYLE",
-                default=["active", "elderly"],
-                help="the style at the start and the style from half-way on",
+                help="the style at the start and the style from half-way on "
+                "(default: active elderly, or a folder's first two styles)",
             ),
             _option(
                 "--no-figures",
                 action="store_true",
-                help="skip the figures (the BVH files are still written)",
+                help="skip the figures and GIFs (the BVH files are still written)",
             ),
         ],
     ),

@@ -29,6 +29,10 @@ PAPER_FILLIN = {
     ("walk", "left leg"): (8.78, 11.68),
     ("walk", "upper body"): (20.52, 22.20),
 }
+# Resolution of the GIFs, and the frames of each sequence they show (every
+# other frame: real time at half the frames).
+GIF_DPI = 60
+GIF_FRAMES, GIF_STEP = 180, 2
 # Generated sequences per seed style, and the frames each is judged on.
 N_PER_STYLE = 3
 JUDGED_FRAMES = 100
@@ -232,7 +236,7 @@ def _draw(args, imputer, preprocessor, Z_train, train, cases, generated):
         )
         return []
     output = args.output
-    written = []
+    written = [_real_and_generated_gif(output, preprocessor, train, generated)]
     for style, (frames, gen_ids) in generated.items():
         raw = preprocessor.inverse_transform(frames, sequence_ids=gen_ids)
         first = raw[gen_ids == 0]
@@ -270,9 +274,48 @@ def _draw(args, imputer, preprocessor, Z_train, train, cases, generated):
     return written
 
 
+def _real_and_generated_gif(output, preprocessor, train, generated):
+    """A real trial of each style beside the first sequence generated from it."""
+    motion = np.asarray(train.motion)
+    sequences, titles = [], []
+    for style, (frames, gen_ids) in generated.items():
+        real = train.data[train.sequence_ids == np.flatnonzero(motion == style)[0]]
+        raw = preprocessor.inverse_transform(frames, sequence_ids=gen_ids)
+        first = raw[gen_ids == 0][:GIF_FRAMES]
+        sequences += [real[: len(first)], first]
+        titles += [f"real {style}", f"generated from {style}"]
+    return save_gif(
+        output / "real_and_generated.gif",
+        train.skeleton,
+        sequences,
+        titles=titles,
+        frame_rate=train.frame_rate,
+        step=GIF_STEP,
+    )
+
+
 def _save(fig, path):
     import matplotlib.pyplot as plt
 
     fig.savefig(path, dpi=100, bbox_inches="tight")
     plt.close(fig)
+    return path
+
+
+def save_gif(path, skeleton, sequences, *, frame_rate, step=1, **kwargs):
+    """Animate ``sequences`` side by side (``animate_motions``) into a GIF.
+
+    Played in real time: ``frame_rate / step`` frames per second.
+    """
+    import matplotlib.pyplot as plt
+
+    from .plotting import animate_motions, save_animation
+
+    height = 3.0 if kwargs.get("proba") is None else 5.0
+    figure = plt.figure(figsize=(max(2.6 * len(sequences), 5.0), height))
+    animation = animate_motions(
+        skeleton, sequences, frame_rate=frame_rate, step=step, figure=figure, **kwargs
+    )
+    save_animation(animation, path, frame_rate=frame_rate / step, dpi=GIF_DPI)
+    plt.close(figure)
     return path

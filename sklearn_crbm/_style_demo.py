@@ -14,7 +14,7 @@ import time
 import numpy as np
 import sklearn
 
-from ._demo import _save
+from ._demo import GIF_FRAMES, GIF_STEP, _save, save_gif
 from .datasets import bone_columns
 from .metrics import StyleJudge
 from .metrics._style import _nanmedian
@@ -61,8 +61,32 @@ def style_requests(classes, n_frames, *, blend, transition):
     return requests
 
 
+# The styles the options default to on the Bandai walks; a folder without
+# them starts from its first style and blends or switches its first two.
+BANDAI_DEFAULTS = dict(
+    seed_style="normal", blend=["elderly", "youthful"], transition=["active", "elderly"]
+)
+
+
+def default_styles(args, styles):
+    """Fill the style options left out, from the data's ``styles``."""
+    for option, default in BANDAI_DEFAULTS.items():
+        if getattr(args, option) is not None:
+            continue
+        wanted = [default] if isinstance(default, str) else default
+        if not set(wanted) <= set(styles):
+            wanted = list(styles[: len(wanted)])
+        setattr(args, option, wanted[0] if isinstance(default, str) else wanted)
+
+
 def check_style_arguments(args, styles):
     """Fail before training when an option names a style the data lack."""
+    if len(styles) < 2:
+        raise ValueError(
+            f"the styles command needs takes of at least two styles; the labels "
+            f"give one ({', '.join(styles)})."
+        )
+    default_styles(args, styles)
     for option, names in (
         ("--seed-style", [args.seed_style]),
         ("--blend", args.blend),
@@ -72,7 +96,7 @@ def check_style_arguments(args, styles):
             if name not in styles:
                 raise ValueError(
                     f"{option}: the walks have no style {name!r}; their styles "
-                    f"are {', '.join(styles)}."
+                    f"are {', '.join(map(str, styles))}."
                 )
     if args.blend[0] == args.blend[1] or args.transition[0] == args.transition[1]:
         raise ValueError("--blend and --transition each need two different styles.")
@@ -93,7 +117,7 @@ def run_styles(args, walks, model):
     styles = sorted(set(labels.tolist()))  # the model's classes_
     check_style_arguments(args, styles)
     print(
-        f"Bandai Namco walks: {len(walks.data)} frames in "
+        f"{walks.name}: {len(walks.data)} frames in "
         f"{len(walks.sequence_names)} takes at {walks.frame_rate:g} frames/s, "
         f"styles {', '.join(styles)}"
     )
@@ -150,7 +174,9 @@ def _generate(pipeline, walks, labels, args):
 def _fit_judge(pipeline, walks, labels):
     """A StyleJudge of 2-s windows, trained on every real take."""
     Z = pipeline[:-1].transform(walks.data, sequence_ids=walks.sequence_ids)
-    legs = bone_columns(pipeline[:-1].get_feature_names_out(), LEGS)
+    names = pipeline[:-1].get_feature_names_out()
+    has_legs = any(name.startswith(f"{bone}_") for name in names for bone in LEGS)
+    legs = bone_columns(names, LEGS, strict=False) if has_legs else None
     return StyleJudge(legs=legs).fit(Z, labels, sequence_ids=walks.sequence_ids)
 
 
@@ -236,7 +262,7 @@ def _draw(walks, generated, judge, judged, args):
         print(f"\nno figures: {exc}")
         return []
     plt.switch_backend("Agg")  # files only, never a window
-    written = []
+    written = _gifs(walks, generated, judge, judged, args)
     for name, (raw, ids) in generated.items():
         first = raw[ids == 0]
         if name.startswith("transition_"):
@@ -253,20 +279,60 @@ def _draw(walks, generated, judge, judged, args):
     return written
 
 
+def _gifs(walks, generated, judge, judged, args):
+    """Every style moving side by side; the transition over the judge's view."""
+    styles = list(judge.classes_)
+    last = [
+        generated[style][0][generated[style][1] == 0][-GIF_FRAMES:] for style in styles
+    ]
+    common = dict(frame_rate=walks.frame_rate, step=GIF_STEP)
+    written = [
+        save_gif(
+            args.output / "styles.gif",
+            walks.skeleton,
+            last,
+            titles=[str(style) for style in styles],
+            **common,
+        )
+    ]
+    a, b = args.transition
+    name = f"transition_{a}_{b}"
+    raw, ids = generated[name]
+    written.append(
+        save_gif(
+            args.output / f"{name}.gif",
+            walks.skeleton,
+            [raw[ids == 0]],
+            titles=[f"{a}, then {b} from frame {args.n_frames // 2}"],
+            proba=_first_sequence_proba(judge, judged[name]),
+            classes=judge.classes_,
+            **common,
+        )
+    )
+    return written
+
+
 def _draw_transition(walks, raw, judge, generated, args):
     """The transition as a strip over the judge's probabilities of the styles."""
     plt = check_matplotlib()
     a, b = args.transition
-    Z, ids = generated
     switch = args.n_frames // 2
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(12, 6))
     plot_motion_strip(walks.skeleton, raw, ax=top)
     top.set_title(f"{a}, then {b} from frame {switch}: the whole sequence")
-    proba = judge.predict_proba(Z[ids == 0], per="frame")
     plot_style_probabilities(
-        proba, classes=judge.classes_, frame_rate=walks.frame_rate, ax=bottom
+        _first_sequence_proba(judge, generated),
+        classes=judge.classes_,
+        frame_rate=walks.frame_rate,
+        ax=bottom,
     )
     bottom.axvline(switch / walks.frame_rate, color="0.3", linestyle="--")
     bottom.set_title("the style judge's probability of each style")
     fig.tight_layout()
     return fig
+
+
+def _first_sequence_proba(judge, judged):
+    """The judge's probability of each style at every frame of the first sequence."""
+    Z, ids = judged
+    return judge.predict_proba(Z[ids == 0], per="frame")

@@ -9,7 +9,9 @@ is not given under the mixture of styles, each weighted by its posterior
 given the frames before.
 """
 
-from numbers import Real
+import hashlib
+import weakref
+from numbers import Integral, Real
 
 import numpy as np
 from scipy.special import logsumexp
@@ -27,6 +29,9 @@ __all__ = ["BaseStyleModel", "check_label_weights"]
 
 # How far a row of label weights may sum from 1.
 _WEIGHT_SUM_TOLERANCE = 1e-6
+# Each estimator's last posterior and the digest of what it came from (see
+# BaseStyleModel._posterior); weak keys: nothing is kept for a deleted model.
+_RECENT_POSTERIORS = weakref.WeakKeyDictionary()
 
 
 def check_label_weights(weights, n_classes, name="style"):
@@ -61,6 +66,11 @@ def _labels_that_compare(name):
         "with the styles seen in fit (such as strings and numbers mixed, or None): "
         "give labels of one kind."
     )
+
+
+def _as_written(labels):
+    """Labels as plain Python values for messages: ``'sad'``, not ``np.str_('sad')``."""
+    return np.asarray(labels).tolist()
 
 
 def _on_host(labels):
@@ -122,7 +132,17 @@ class BaseStyleModel(BaseLayerModel):
                 except TypeError:
                     raise _labels_that_compare("y") from None
             weights = self._one_hot(labels, "y")
+        if reset:
+            self._check_several_classes()
         return self._as_context(weights, X)
+
+    def _check_several_classes(self):
+        if len(self.classes_) < 2:
+            raise ValueError(
+                f"{type(self).__name__} learns what sets styles apart, but y holds "
+                f"one class ({_as_written(self.classes_[0])!r}): give frames of at "
+                "least two styles, or model one style with ConditionalRBM."
+            )
 
     def _one_hot(self, labels, name):
         """Weights that put each label's whole weight on its class."""
@@ -135,8 +155,8 @@ class BaseStyleModel(BaseLayerModel):
         unseen = classes[index] != labels
         if np.any(unseen):
             raise ValueError(
-                f"{name} holds the style {labels[np.argmax(unseen)]!r}, not seen in "
-                f"fit; the styles are {list(classes)}."
+                f"{name} holds the style {_as_written(labels[np.argmax(unseen)])!r}, "
+                f"not seen in fit; the styles are {_as_written(classes)}."
             )
         return np.eye(len(classes))[index]
 
@@ -209,9 +229,22 @@ class BaseStyleModel(BaseLayerModel):
     # the posterior of a style the evidence rules out underflows to 0: exact
     @np.errstate(under="ignore")
     def _posterior(self, X, sequences, log_likelihoods=None):
-        """Each frame's sequence's posterior over the styles, (n_frames, K)."""
+        """Each frame's sequence's posterior over the styles, (n_frames, K).
+
+        The last posterior is kept, keyed on the frames, the sequences, the
+        parameters and the priors: ``predict`` then ``predict_proba`` of the
+        same frames (the usual pair) anneal once per style, not twice.
+        """
         if log_likelihoods is None:
-            log_likelihoods = self._class_log_likelihoods(X, sequences)
+            key = self._posterior_key(X, sequences)
+            kept = _RECENT_POSTERIORS.get(self)
+            if kept is not None and kept[0] == key:
+                return kept[1].copy()
+            posterior = self._posterior(
+                X, sequences, self._class_log_likelihoods(X, sequences)
+            )
+            _RECENT_POSTERIORS[self] = (key, posterior.copy())
+            return posterior
         valid = np.zeros(X.shape[0], dtype=bool)
         valid[sequences.valid_frames(self.history_length)] = True
         posterior = np.empty_like(log_likelihoods)
@@ -229,6 +262,20 @@ class BaseStyleModel(BaseLayerModel):
             context = self._as_context(self._style_weights(y, X.shape[0], name), X)
             return self._log_likelihood(X, sequences, context=context).log_likelihood
         return self._as_context(self._mixture_log_likelihoods(X, sequences), X)
+
+    def _posterior_key(self, X, sequences):
+        """A digest of everything :meth:`_posterior` depends on."""
+        digest = hashlib.blake2b(digest_size=16)
+        arrays = [X, sequences.starts, sequences.lengths]
+        arrays += [layer.flat for layer in self._layers()]
+        for array in arrays:
+            array = np.ascontiguousarray(to_numpy(array))
+            digest.update(f"{array.dtype}{array.shape}".encode())
+            digest.update(array.data)
+        seed = self.random_state if isinstance(self.random_state, Integral) else None
+        settings = (self.priors, self.ais_steps, self.ais_chains, seed)
+        digest.update(repr(settings).encode())
+        return digest.digest()
 
     @np.errstate(under="ignore")
     def _mixture_log_likelihoods(self, X, sequences):
@@ -256,7 +303,9 @@ class BaseStyleModel(BaseLayerModel):
         By Bayes' rule from the conditional log-likelihoods ``log p(x_t |
         past, style)`` of the sequence's frames that have a full past (all
         its frames if it has none) and ``priors`` (equal unless given).
-        Every frame of a sequence gets its sequence's posterior.
+        Every frame of a sequence gets its sequence's posterior.  The last
+        posterior is kept: :meth:`predict`, :meth:`predict_proba` and this
+        method on the same frames (and the same parameters) compute it once.
 
         Parameters
         ----------

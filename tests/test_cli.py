@@ -2,6 +2,7 @@
 
 import argparse
 import io
+import re
 import sys
 import tempfile
 from contextlib import redirect_stdout
@@ -11,6 +12,7 @@ import numpy as np
 import pytest
 import sklearn
 from numpy.testing import assert_array_equal
+from PIL import Image
 
 from sklearn_crbm import _cli, _cli_options, _style_demo
 from sklearn_crbm._cli import main
@@ -69,11 +71,23 @@ def test_demo_prints_the_tables_and_writes_figures(data_home, tmp_path, capsys):
         "hidden_activations.png",
     ):
         assert (tmp_path / name).stat().st_size > 1000
+    # real beside generated, moving: every frame of the 40 generated, halved
+    gif = Image.open(tmp_path / "real_and_generated.gif")
+    assert gif.n_frames == 20
     skeleton = load_cmu35(data_home, subset="test").skeleton
     data, names = read_amc(tmp_path / "generated_walk.amc", skeleton)
     assert data.shape == (40, 62) and np.isfinite(data).all()
     _, bvh, _, rate = read_bvh(tmp_path / "generated_walk.bvh")
     assert bvh.shape[0] == 40 and rate == 30.0
+
+
+def test_getting_started_shows_a_small_gif_of_the_demo():
+    doc = Path(__file__).parents[1] / "doc"
+    page = (doc / "getting_started.rst").read_text(encoding="utf-8")
+    (name,) = re.findall(r"\.\. figure:: (_static/\S+\.gif)", page)
+    gif = Image.open(doc / name)
+    assert gif.n_frames >= 60  # it moves: at least 4 s at 15 frames/s
+    assert (doc / name).stat().st_size < 400_000
 
 
 def test_demo_table_rows_are_compare_imputers_numbers(data_home, tmp_path, capsys):
@@ -314,9 +328,13 @@ def test_styles_writes_every_style_a_blend_and_a_transition(styles_run, data_hom
     status, out, output = styles_run
     assert status == 0
     expected = sorted(
-        f"{name}{suffix}" for name in WRITTEN for suffix in (".bvh", ".png")
+        [f"{name}{suffix}" for name in WRITTEN for suffix in (".bvh", ".png")]
+        + ["styles.gif", "transition_active_elderly.gif"]
     )
     assert sorted(p.name for p in output.iterdir()) == expected
+    # the last 180 of 240 frames of every style, every other frame
+    assert Image.open(output / "styles.gif").n_frames == 90
+    assert Image.open(output / "transition_active_elderly.gif").n_frames == 120
     walks = load_bandai_walks(data_home)
     for name in WRITTEN:
         raw = _read_raw_channels(output / f"{name}.bvh", walks)
@@ -464,3 +482,93 @@ def test_fetch_downloads_the_data_sets_asked_for(tmp_path, capsys, monkeypatch):
     fetched.clear()
     assert main(["fetch", "--dataset", "bandai", "--dataset", "cmu35", *home]) == 0
     assert fetched == ["fetch_bandai_walks", "fetch_cmu35"]
+
+
+# -- errors in the command's terms; a user's labelled folder (issue 38) ------
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["fit", "--n-iter", "0"], "argument --n-iter: must be at least 1, got 0"),
+        (["sample", "m.joblib", "--n-frames", "0"], "argument --n-frames: must be"),
+        (["fit", "--order", "x"], "argument --order: must be a whole number, got 'x'"),
+        (["styles", "--n-sequences", "0"], "argument --n-sequences: must be at"),
+        (["fit", "--frame-rate", "-1"], "argument --frame-rate: must be positive"),
+    ],
+)
+def test_bad_counts_are_named_by_their_flags(argv, message, capsys):
+    with pytest.raises(SystemExit):
+        main(argv)
+    err = capsys.readouterr().err
+    assert message in err and "parameter of" not in err
+
+
+def _walker_folder(folder, rate, styles=("slow", "fast"), n_frames=150):
+    """Two takes of every style, written with the package's BVH writer."""
+    folder.mkdir()
+    for k, style in enumerate(styles):
+        for take in (1, 2):
+            walker = make_walker(n_sequences=1, n_frames=n_frames, random_state=k)
+            name = f"walk_{style}_{take:03d}"
+            write_bvh(folder / f"{name}.bvh", walker.data, walker.skeleton, rate)
+            (folder / f"{name}.json").write_text(f'{{"style": {k}}}')
+    (folder / "style_label.txt").write_text("\n".join(styles))
+    return folder
+
+
+def test_order_longer_than_the_takes_names_the_flag(tmp_path, capsys):
+    folder = _walker_folder(tmp_path / "mine", 30.0, n_frames=20)
+    assert main(["fit", str(folder), *TINY, "--order", "200"]) == 1
+    err = capsys.readouterr().err
+    assert "--order 200 needs sequences of more than 200 frames" in err
+    assert "longest training sequence has 20 frames" in err
+    assert "sequence_ids" not in err
+
+
+def test_fit_trains_at_the_files_own_rate_and_names_frame_rate(tmp_path, capsys):
+    folder = _walker_folder(tmp_path / "mine", 24.0, n_frames=30)
+    model = str(tmp_path / "m.joblib")
+    assert main(["fit", str(folder), *TINY, "--output", model]) == 0
+    assert "at 24 frames/s" in capsys.readouterr().out
+    assert main(["fit", str(folder), *TINY, "--frame-rate", "30"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("error: --frame-rate 30: Cannot bring 24 frames")
+    assert "--frame-rate sets the rate to train at" in err
+
+
+@pytest.mark.parametrize("labels", ["style", "walk_([a-z]+)_"])
+def test_fit_labels_keep_seeds_of_each_label_for_sample(tmp_path, capsys, labels):
+    folder = _walker_folder(tmp_path / "mine", 30.0)
+    model = tmp_path / "m.joblib"
+    argv = ["fit", str(folder), "--labels", labels, *TINY, "--output", str(model)]
+    assert main(argv) == 0
+    assert "labels fast, slow" in capsys.readouterr().out
+    assert list(_cli._load_model(model).seed_windows) == ["fast", "slow"]
+    prefix = tmp_path / "fast"
+    argv = ["sample", str(model), "--style", "fast", "--n-frames", "12"]
+    argv += ["--n-sequences", "2", "--output", str(prefix), "--animate"]
+    assert main(argv) == 0
+    assert read_bvh(f"{prefix}_1.bvh")[1].shape[0] == 12
+    assert Image.open(f"{prefix}.gif").n_frames == 12
+
+
+def test_styles_runs_on_a_users_labelled_folder(tmp_path, capsys):
+    folder = _walker_folder(tmp_path / "mine", 30.0, styles=("slow", "fast", "odd"))
+    output = tmp_path / "out"
+    argv = ["styles", "--folder", str(folder), "--output", str(output)]
+    argv += [*STYLES_TINY[:-4], "--n-frames", "120", "--n-gibbs", "2"]
+    argv += ["--order", "2", "--n-sequences", "1"]
+    assert main(argv) == 0, capsys.readouterr().err
+    out = capsys.readouterr().out
+    assert f"the motion in {folder}: 900 frames in 6 takes" in out
+    assert "styles fast, odd, slow" in out
+    assert "transition fast -> odd at frame 60" in out  # its first two styles
+    bones = read_bvh(folder / "walk_odd_001.bvh")[0].bone_names
+    for name in ("fast", "odd", "slow", "blend_fast_odd", "transition_fast_odd"):
+        skeleton, data, _, rate = read_bvh(output / f"{name}.bvh")
+        assert data.shape[0] == 120 and rate == 30.0 and np.isfinite(data).all()
+        assert skeleton.bone_names == bones
+        assert (output / f"{name}.png").stat().st_size > 1000
+    assert Image.open(output / "styles.gif").n_frames == 60
+    assert Image.open(output / "transition_fast_odd.gif").n_frames == 60

@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 from sklearn.utils import Bunch
 
+from ..utils._sequences import remember_sequences
 from ._bandai import BANDAI_FOLDER
 from ._folders import read_bvh_folder
 from ._frame_rate import kept_frames
@@ -180,9 +181,11 @@ def load_cmu35(data_home=None, *, subset="all"):
             f"{mat_path} has {data.shape[1]} channels but {asf_path} describes "
             f"{len(skeleton.feature_names)}."
         )
+    sequence_ids = np.concatenate(ids)
+    remember_sequences(data, sequence_ids)
     return Bunch(
         data=data,
-        sequence_ids=np.concatenate(ids),
+        sequence_ids=sequence_ids,
         sequence_names=np.array(names, dtype=object),
         motion=np.array(
             ["jog" if n in CMU35_JOGS else "walk" for n in names], dtype=object
@@ -243,9 +246,12 @@ def load_mit_walk(data_home=None):
         motion[kept_frames(len(motion), MIT_RECORDING_RATE, FRAME_RATE)]
         for motion in motions
     ]
+    data = np.concatenate(sequences)
+    sequence_ids = np.repeat(np.arange(len(sequences)), [len(s) for s in sequences])
+    remember_sequences(data, sequence_ids)
     return Bunch(
-        data=np.concatenate(sequences),
-        sequence_ids=np.repeat(np.arange(len(sequences)), [len(s) for s in sequences]),
+        data=data,
+        sequence_ids=sequence_ids,
         sequence_names=np.array(MIT_SEQUENCE_NAMES[: len(sequences)], dtype=object),
         motion=np.array(["walk"] * len(sequences), dtype=object),
         feature_names=skeleton.feature_names,

@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 from sklearn.utils import Bunch
 
+from ..utils._sequences import remember_sequences
 from ._acclaim import read_amc
 from ._bvh import read_bvh
 from ._frame_rate import RATIO_TOLERANCE, check_rate, kept_frames
@@ -279,9 +280,12 @@ def _long_format(folder, sequences, frame_rate, kind):
         path.relative_to(folder).with_suffix("").as_posix()
         for path, _, _, _ in sequences
     ]
+    data = np.concatenate(kept)
+    sequence_ids = np.repeat(np.arange(len(kept)), [len(d) for d in kept])
+    remember_sequences(data, sequence_ids)
     return Bunch(
-        data=np.concatenate(kept),
-        sequence_ids=np.repeat(np.arange(len(kept)), [len(d) for d in kept]),
+        data=data,
+        sequence_ids=sequence_ids,
         sequence_names=np.array(names, dtype=object),
         feature_names=first_skeleton.feature_names,
         skeleton=first_skeleton,

@@ -7,7 +7,9 @@ matplotlib is imported only when a function is called.
 - :func:`plot_motion_strip`: every few frames side by side (paper Fig. 3).
 - :func:`animate_motion`, :func:`save_animation`, :func:`motion_to_html`:
   a moving stick figure as a matplotlib animation, a GIF/MP4/HTML file, or
-  an HTML/JavaScript player for notebooks.
+  an HTML/JavaScript player for notebooks; :func:`animate_motions`: several
+  sequences side by side (real beside generated, one per style), optionally
+  over the probability of each style.
 - :func:`plot_hidden_activations`: hidden probabilities over frames
   (paper Fig. 1).
 - :func:`plot_filled_channels`: filled-in against true channels, with a
@@ -23,6 +25,7 @@ from ._figures import (
 )
 from ._skeleton import (
     animate_motion,
+    animate_motions,
     motion_to_html,
     plot_motion_strip,
     plot_skeleton,
@@ -31,6 +34,7 @@ from ._skeleton import (
 
 __all__ = [
     "animate_motion",
+    "animate_motions",
     "motion_to_html",
     "plot_filled_channels",
     "plot_hidden_activations",

@@ -10,6 +10,7 @@ from ._base import check_matplotlib, get_axes
 
 __all__ = [
     "animate_motion",
+    "animate_motions",
     "motion_to_html",
     "plot_motion_strip",
     "plot_skeleton",
@@ -486,17 +487,43 @@ def animate_motion(
     """
     check_matplotlib()
     from matplotlib.animation import FuncAnimation
-    from matplotlib.collections import LineCollection
 
+    frame_rate = _check_frame_rate(frame_rate)
+    ax = get_axes(ax)
+    update, n_frames = _motion_updater(
+        ax, skeleton, data, feature_names, follow, horizontal, color, linewidth, title
+    )
+    update(0)
+    return FuncAnimation(
+        ax.figure,
+        update,
+        frames=n_frames,
+        interval=1000.0 / frame_rate,
+        blit=False,
+    )
+
+
+def _check_frame_rate(frame_rate):
     if isinstance(frame_rate, bool) or not isinstance(frame_rate, Real):
         raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
     if not frame_rate > 0:
         raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
+    return float(frame_rate)
+
+
+def _motion_updater(
+    ax, skeleton, data, feature_names, follow, horizontal, color, linewidth, title
+):
+    """Draw frame 0 of a sequence on ``ax``; ``(update(k), n_frames)``.
+
+    ``update(k)`` draws frame ``k`` (the last frame for ``k`` beyond it).
+    """
+    from matplotlib.collections import LineCollection
+
     body, positions = _positions(skeleton, data, feature_names)
     segments, points = _side_segments(body, positions, horizontal)
     up = _AXES.index(body.up_axis)
     height = _height(positions, up)
-    ax = get_axes(ax)
     lines = LineCollection(segments[0], colors=color, linewidths=linewidth)
     ax.add_collection(lines)
     low = points[..., 1].min() - 0.05 * height
@@ -513,6 +540,7 @@ def animate_motion(
     ax.set_yticks([])
 
     def update(k):
+        k = min(k, len(segments) - 1)
         lines.set_segments(segments[k])
         if follow:
             ax.set_xlim(points[k, 0, 0] - half, points[k, 0, 0] + half)
@@ -520,12 +548,135 @@ def animate_motion(
             ax.set_title(f"{title}  frame {k}")
         return (lines,)
 
-    update(0)
+    return update, len(positions)
+
+
+def animate_motions(
+    skeleton,
+    sequences,
+    *,
+    titles=None,
+    feature_names=None,
+    frame_rate=30.0,
+    step=1,
+    proba=None,
+    classes=None,
+    follow=True,
+    horizontal=None,
+    panel_width=2.6,
+    figure=None,
+):
+    """Animate several sequences side by side, frame by frame together.
+
+    Real motion beside generated motion, or one generated sequence per
+    style: each sequence gets its own panel (side view, up axis vertical),
+    and every panel shows the same frame.  With ``proba``, a panel below
+    plots the probability of each style over the frames (see
+    :func:`~sklearn_crbm.plotting.plot_style_probabilities`) with a line at
+    the frame shown.  Save it with :func:`save_animation`, at
+    ``frame_rate / step`` frames per second to play in real time.
+
+    Parameters
+    ----------
+    skeleton : Skeleton
+        Bones and their channels (the same for every sequence).
+    sequences : list of array-like of shape (n_frames, n_features)
+        Raw channels of each sequence; a shorter one stays at its last frame.
+    titles : list of str, default=None
+        The title of each panel.
+    feature_names : array-like of str, default=None
+        Name of each channel; default ``skeleton.feature_names``.
+    frame_rate : float, default=30.0
+        Frames per second of the data.
+    step : int, default=1
+        Show every ``step``-th frame (a smaller file).
+    proba : array-like of shape (n_frames, n_classes), default=None
+        Probability of each style at every frame of the sequences, drawn
+        below them.
+    classes : array-like of shape (n_classes,), default=None
+        The names of the styles of ``proba``.
+    follow : bool, default=True
+        Move each panel's view with its root (see :func:`animate_motion`).
+    horizontal : array-like of shape (3,) or (2,) or "facing", default=None
+        As for :func:`animate_motion`.
+    panel_width : float, default=2.6
+        Width of each panel, in inches (of a new figure).
+    figure : matplotlib Figure, default=None
+        Where to draw (an empty figure); default a new one.
+
+    Returns
+    -------
+    animation : matplotlib.animation.FuncAnimation
+        One animation frame per ``step`` data frames of the longest sequence.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> from sklearn_crbm.datasets import make_walker
+    >>> from sklearn_crbm.plotting import animate_motions
+    >>> walker = make_walker(n_sequences=2, n_frames=12, random_state=0)
+    >>> first, second = walker.data[:12], walker.data[12:]
+    >>> animation = animate_motions(walker.skeleton, [first, second],
+    ...                             titles=["real", "generated"], step=2)
+    >>> len(list(animation.new_frame_seq()))
+    6
+    """
+    plt = check_matplotlib()
+    from matplotlib.animation import FuncAnimation
+
+    frame_rate = _check_frame_rate(frame_rate)
+    if isinstance(step, bool) or not isinstance(step, Integral) or step < 1:
+        raise ValueError(f"step must be a positive integer, got {step!r}.")
+    sequences = list(sequences)
+    if not sequences:
+        raise ValueError("sequences must hold at least one sequence.")
+    titles = [None] * len(sequences) if titles is None else list(titles)
+    if len(titles) != len(sequences):
+        raise ValueError(
+            f"titles must name each of the {len(sequences)} sequences, got "
+            f"{len(titles)} titles."
+        )
+    rows = 1 if proba is None else 2
+    if figure is None:
+        figure = plt.figure(
+            figsize=(max(panel_width * len(sequences), 5.0), 3.0 + 2.0 * (rows - 1))
+        )
+    grid = figure.add_gridspec(rows, len(sequences), height_ratios=[3, 2][:rows])
+    updates, n_frames = [], 0
+    for k, (data, title) in enumerate(zip(sequences, titles, strict=True)):
+        ax = figure.add_subplot(grid[0, k])
+        if title is not None:
+            ax.set_title(title, fontsize=9)
+        update, length = _motion_updater(
+            ax, skeleton, data, feature_names, follow, horizontal, "k", 2.0, None
+        )
+        updates.append(update)
+        n_frames = max(n_frames, length)
+    if proba is not None:
+        from ._figures import plot_style_probabilities
+
+        ax = figure.add_subplot(grid[1, :])
+        plot_style_probabilities(proba, classes=classes, frame_rate=frame_rate, ax=ax)
+        ax.legend(fontsize=7, ncols=4, loc="upper right")
+        cursor = ax.axvline(0.0, color="0.2", linewidth=1.0)
+
+        def move_cursor(k):
+            cursor.set_xdata([k / frame_rate] * 2)
+
+        updates.append(move_cursor)
+    figure.tight_layout()
+
+    def update_all(k):
+        for update in updates:
+            update(k)
+
+    update_all(0)
     return FuncAnimation(
-        ax.figure,
-        update,
-        frames=len(positions),
-        interval=1000.0 / frame_rate,
+        figure,
+        update_all,
+        frames=range(0, n_frames, step),
+        interval=1000.0 * step / frame_rate,
         blit=False,
     )
 

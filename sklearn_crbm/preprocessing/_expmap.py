@@ -27,6 +27,7 @@ from ._layout import (
     find_euler_blocks,
     input_names,
     moving_root,
+    output_dtype,
     skeleton_feature_names,
 )
 
@@ -262,6 +263,7 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
             Output columns as given by :meth:`get_feature_names_out`.
         """
         check_is_fitted(self)
+        dtype = output_dtype(X)
         X = validate_data(
             self, X, reset=False, dtype=np.float64, ensure_all_finite="allow-nan"
         )
@@ -279,7 +281,7 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
                     r[start:stop] = unwrap_expmap(r[start:stop])
             starts = self._block_starts[members]
             out[:, starts[:, None] + np.arange(3)] = r
-        return out
+        return out.astype(dtype, copy=False)
 
     def inverse_transform(self, X, *, sequence_ids=None):
         """Euler angles back from exponential maps, in the original layout.
@@ -298,6 +300,7 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
             degrees (see Notes of the class).
         """
         check_is_fitted(self)
+        dtype = output_dtype(X)
         X = check_encoded(X, len(self._names_out), type(self).__name__)
         check_sequence_ids(sequence_ids, X.shape[0])
         out = np.empty((X.shape[0], self.n_features_in_), dtype=np.float64)
@@ -309,7 +312,7 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
             angles = matrix_to_euler(R, axes) / self._scale()
             cols = np.array([self._blocks[i].columns for i in members])
             out[:, cols] = angles
-        return out
+        return out.astype(dtype, copy=False)
 
     def get_feature_names_out(self, input_features=None):
         """Output feature names.
@@ -348,4 +351,5 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
         tags.input_tags.allow_nan = True
+        tags.transformer_tags.preserves_dtype = ["float64", "float32"]
         return tags

@@ -246,6 +246,12 @@ def expmap_feature_names(skeleton):
     return expmap_layout(names, find_euler_blocks(names, skeleton))[0]
 
 
+def output_dtype(X):
+    """The dtype an encoder returns for ``X``: float32 for float32 input, else
+    float64 (encoders compute in float64 either way)."""
+    return np.float32 if getattr(X, "dtype", None) == np.float32 else np.float64
+
+
 def check_encoded(X, n_features, name):
     """Validate the input of an ``inverse_transform``: 2-D, numeric, right width."""
     X = check_array(X, dtype=np.float64, ensure_all_finite="allow-nan")

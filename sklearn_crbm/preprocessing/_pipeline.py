@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 import sklearn
+from scipy.sparse import issparse
 from sklearn.pipeline import Pipeline
 from sklearn.utils.metaestimators import available_if
 
@@ -11,6 +12,7 @@ from ..datasets import write_amc, write_bvh
 from ..datasets._up_axis import check_up_axis
 from ..metrics import forward_speed
 from ..utils import random_windows
+from ..utils._sequences import warn_if_sequences_unmarked
 from ._data import StandardScaler
 from ._expmap import ExpMapEncoder
 from ._root import RootRelativeEncoder
@@ -54,7 +56,11 @@ class MotionPipeline(Pipeline):
       length units.
 
     Its ``fit`` and ``fit_transform`` say how to turn metadata routing on if
-    ``sequence_ids`` is passed without it.
+    ``sequence_ids`` is passed without it, and warn when ``X`` is the data of
+    a loader's result of several sequences (files) given without them.  With
+    a final model that needs complete frames, ``fit``, ``fit_transform`` and
+    ``transform`` point frames with NaN to
+    :class:`~sklearn_crbm.impute.CRBMImputer`.
 
     Parameters
     ----------
@@ -92,17 +98,51 @@ class MotionPipeline(Pipeline):
     """
 
     def fit(self, X, y=None, **params):
-        _check_routing(params)
-        self._validate_params()  # the steps, before the up axis reads them
-        self._check_up_axis(X)
+        self._check_fit_input(X, params, "fit")
         return super().fit(X, y, **params)
 
     @available_if(Pipeline._can_fit_transform)
     def fit_transform(self, X, y=None, **params):
-        _check_routing(params)
-        self._validate_params()
-        self._check_up_axis(X)
+        self._check_fit_input(X, params, "fit_transform")
         return super().fit_transform(X, y, **params)
+
+    @available_if(Pipeline._can_transform)
+    def transform(self, X, **params):
+        self._check_complete(X, "transform")
+        return super().transform(X, **params)
+
+    def _check_fit_input(self, X, params, method):
+        _check_routing(params)
+        self._validate_params()  # the steps, before the up axis reads them
+        warn_if_sequences_unmarked(
+            X, params.get("sequence_ids"), f"{type(self).__name__}.{method}", 4
+        )
+        self._check_complete(X, method)
+        self._check_up_axis(X)
+
+    def _check_complete(self, X, method):
+        """Point to CRBMImputer when a final model that needs complete frames
+        is given frames with NaN (the preprocessing steps pass NaN through)."""
+        model = self._final_estimator
+        if model == "passthrough" or model is None or not _has_sampler(self):
+            return
+        if model.__sklearn_tags__().input_tags.allow_nan or issparse(X):
+            return  # the steps say what they think of sparse input
+        try:
+            values = np.asarray(X, dtype=np.float64)
+        except (TypeError, ValueError):
+            return  # not numbers: the steps' validation says so
+        missing = np.isnan(values)
+        if not missing.any():
+            return
+        frames = np.flatnonzero(missing.any(axis=1))
+        raise ValueError(
+            f"X holds NaN in {len(frames)} of its {len(values)} frames (the first "
+            f"at frame {frames[0]}), but {type(self).__name__}.{method} needs "
+            f"every channel of every frame for its {type(model).__name__}. Fill "
+            "the gaps first with sklearn_crbm.impute.CRBMImputer (a model of "
+            "the motion fills them in, frame by frame), or leave those frames out."
+        )
 
     def _check_up_axis(self, X):
         """Warn when a root encoder's explicit ``up_axis`` is not the one the
@@ -166,6 +206,7 @@ class MotionPipeline(Pipeline):
             (``skeleton.feature_names``): rows ``k * n_frames`` to
             ``(k + 1) * n_frames - 1`` are sequence ``k``.
         """
+        self._check_history(history)
         frames = self._final_estimator.sample(
             n_frames,
             history=history,
@@ -179,6 +220,30 @@ class MotionPipeline(Pipeline):
             return self[:-1].inverse_transform(
                 np.asarray(frames), sequence_ids=sequence_ids
             )
+
+    def _check_history(self, history):
+        """Say in the raw channels' terms what a seed of the wrong shape lacks."""
+        shape = np.shape(history) if history is not None else None
+        model = self._final_estimator
+        width = max(model.history_length, 1)
+        n_model = getattr(model, "n_features_in_", None)
+        if shape is None or len(shape) not in (2, 3) or n_model is None:
+            return  # the model's own checks say what is wrong
+        n_raw = len(self.skeleton.feature_names)
+        if shape[-1] == n_model and shape[-2] >= width:
+            return
+        frames = f"{shape[-2]} frame{'s' * (shape[-2] != 1)}"
+        got = (
+            f"{frames} of the skeleton's {n_raw} raw channels"
+            if shape[-1] == n_raw
+            else f"{frames} of {shape[-1]} channels"
+        )
+        raise ValueError(
+            f"history holds {got}, but sample seeds the model in its own space: "
+            f"take at least {width} raw frames of {n_raw} channels through the "
+            f"preprocessing (history=pipe[:-1].transform(raw_frames), which gives "
+            f"{n_model} features per frame), or seeds from style_windows."
+        )
 
     @available_if(_has_sampler)
     def style_windows(

@@ -25,6 +25,7 @@ from ._layout import (
     expmap_feature_names,
     input_names,
     moving_root,
+    output_dtype,
 )
 
 __all__ = ["RootRelativeEncoder"]
@@ -480,6 +481,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             Output columns as given by :meth:`get_feature_names_out`.
         """
         check_is_fitted(self)
+        dtype = output_dtype(X)
         X = validate_data(
             self, X, reset=False, dtype=np.float64, ensure_all_finite="allow-nan"
         )
@@ -508,7 +510,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         out = np.empty_like(X)
         out[:, self._pass_out] = X[:, self._pass_in]
         out[:, self._root_out] = np.column_stack([encoded[c] for c in self._outputs])
-        return out
+        return out.astype(dtype, copy=False)
 
     def _local_positions(self, X):
         """Root positions in (forward, left, up) coordinates; 0 where absent."""
@@ -611,6 +613,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             Channels with the global root position and exponential map.
         """
         check_is_fitted(self)
+        dtype = output_dtype(X)
         X = check_encoded(X, self.n_features_in_, type(self).__name__)
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
         n = X.shape[0]
@@ -633,7 +636,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             )
         elif "dheading" in self._outputs:
             out[:, self._column[f"e{self.up_axis_}"]] = heading
-        return out
+        return out.astype(dtype, copy=False)
 
     def _rotations(self, pitch, roll, heading):
         """Root rotations in (forward, left, up) coordinates from the angles."""
@@ -674,4 +677,5 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
         tags.input_tags.allow_nan = True
+        tags.transformer_tags.preserves_dtype = ["float64", "float32"]
         return tags

@@ -7,6 +7,8 @@ needs the past of a frame gets it from here by index arithmetic, so no
 estimator ever materialises the history of the whole data set.
 """
 
+import warnings
+import weakref
 from dataclasses import dataclass
 from numbers import Integral
 
@@ -22,13 +24,61 @@ __all__ = [
     "frame_history",
     "history_indices",
     "shuffled_batches",
+    "remember_sequences",
     "validation_split",
+    "warn_if_sequences_unmarked",
 ]
 
 
 # Frames whose histories are gathered at once by the loops over whole data
 # sets (transform, score and friends): bounds their memory on long data.
 CHUNK_FRAMES = 4096
+
+
+# Arrays whose sequences a loader knows: id(array) -> (weak reference,
+# number of sequences); see remember_sequences.
+_KNOWN_SEQUENCES = {}
+
+
+def remember_sequences(X, sequence_ids):
+    """Note that the array ``X`` (a loader's result) holds the sequences of
+    ``sequence_ids``, so that a ``fit`` given ``X`` without them can warn."""
+    key = id(X)
+    forget = lambda _, key=key: _KNOWN_SEQUENCES.pop(key, None)  # noqa: E731
+    n_sequences = len(np.unique(sequence_ids))
+    _KNOWN_SEQUENCES[key] = (weakref.ref(X, forget), n_sequences)
+
+
+def _known_sequence_count(X):
+    """The number of sequences a loader said ``X`` (or the array it views) holds."""
+    while isinstance(X, np.ndarray):
+        reference, n_sequences = _KNOWN_SEQUENCES.get(id(X), (None, None))
+        if reference is not None and reference() is X:
+            return n_sequences
+        if X.base is None or len(X.base) != len(X):
+            return None
+        X = X.base
+    return None
+
+
+def warn_if_sequences_unmarked(X, sequence_ids, method, stacklevel=3):
+    """Warn when ``X`` is a loader's array of several sequences and
+    ``sequence_ids`` is None: every frame would count as one sequence."""
+    if sequence_ids is not None:
+        return
+    n_sequences = _known_sequence_count(X)
+    if n_sequences is None or n_sequences < 2:
+        return
+    warnings.warn(
+        f"{method} got no sequence_ids, but X is the data of a loader's result "
+        f"that holds {n_sequences} sequences (files): they are treated as one "
+        "sequence, and the jumps between them as motion. Pass sequence_ids="
+        "data.sequence_ids (through a Pipeline, after sklearn.set_config("
+        "enable_metadata_routing=True)); to cross-validate, split whole "
+        "sequences: cv=GroupKFold() with groups=data.sequence_ids.",
+        UserWarning,
+        stacklevel=stacklevel,
+    )
 
 
 @dataclass(frozen=True)
