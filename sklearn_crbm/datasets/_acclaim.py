@@ -6,7 +6,13 @@ import numpy as np
 
 from ._asf import content_lines
 from ._channels import frame_columns
-from ._parsing import format_number, parse_error, parse_floats
+from ._parsing import (
+    bvh_hint,
+    check_bone_names,
+    format_number,
+    parse_error,
+    parse_floats,
+)
 from ._skeleton import Skeleton
 from ._up_axis import check_up_axis
 
@@ -67,13 +73,24 @@ def read_amc(path, skeleton):
                 )
             _check_amc_unit(path, lineno, tokens[0], skeleton)
             continue
-        if len(tokens) == 1 and tokens[0].lstrip("-").isdigit():
+        if len(tokens) == 1 and _is_frame_number(tokens[0]):
+            number = int(tokens[0])
             if frame is not None:
                 frames.append(_finish_frame(path, frame, layout))
-            frame = {"line": lineno, "row": np.full(n_features, np.nan), "seen": set()}
+                _check_frame_number(path, lineno, number, frame["number"])
+            frame = {
+                "line": lineno,
+                "number": number,
+                "row": np.full(n_features, np.nan),
+                "seen": set(),
+            }
             continue
         if frame is None:
-            raise parse_error(path, lineno, f"expected a frame number, got {text!r}")
+            raise parse_error(
+                path,
+                lineno,
+                f"expected a frame number, got {text!r}" + bvh_hint(tokens[0]),
+            )
         _amc_bone_line(path, lineno, tokens, frame, layout)
     if frame is not None:
         frames.append(_finish_frame(path, frame, layout))
@@ -151,6 +168,23 @@ def _amc_bone_line(path, lineno, tokens, frame, layout):
     frame["seen"].add(name)
 
 
+def _is_frame_number(token):
+    return len(token) < 19 and token.isascii() and token.lstrip("-").isdigit()
+
+
+def _check_frame_number(path, lineno, number, previous):
+    """Frames are numbered one by one: a gap, a repeat or a step back means
+    frames are missing or out of order, and reading on would shift time."""
+    if number != previous + 1:
+        raise parse_error(
+            path,
+            lineno,
+            f"frame {number} follows frame {previous}; AMC frames are numbered "
+            f"one by one, so frame {previous + 1} was expected (frames missing, "
+            "repeated or out of order?)",
+        )
+
+
 def _finish_frame(path, frame, layout):
     missing = [name for name in layout if name not in frame["seen"]]
     if missing:
@@ -197,6 +231,7 @@ def write_amc(path, data, skeleton, feature_names=None):
     True
     """
     skeleton = _check_skeleton(skeleton, "write_amc")
+    check_bone_names(skeleton.bone_names, "AMC")
     X = _ordered_channels(data, skeleton, feature_names)
     unit = ":DEGREES" if skeleton.angle_unit == "deg" else ":RADIANS"
     lines = [

@@ -4,17 +4,20 @@ The parser gives the keyword arguments of :class:`Skeleton` (its bones and
 settings), so that it needs the bones alone and not the skeleton class.
 """
 
+import heapq
+from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
 
 from ._bone import Bone
 from ._channels import EULER_CHANNELS, TRANSLATION_CHANNELS
-from ._parsing import parse_error, parse_floats, read_lines
+from ._parsing import bvh_hint, format_number, parse_error, parse_floats, read_lines
 
 __all__ = ["parse_asf"]
 
 _ASF_DOFS = EULER_CHANNELS + TRANSLATION_CHANNELS
+_ONCE_PER_BONE = ("name", "direction", "length", "axis", "dof")
 
 
 def content_lines(path):
@@ -39,6 +42,7 @@ class _AsfParser:
         self.units = {"length": 1.0, "angle": "deg"}
         self.root = None
         self.bones = []  # dicts in file order
+        self.names = {"root"}
         self.parents = {}
         self.last_line = 0
 
@@ -67,7 +71,9 @@ class _AsfParser:
                 continue
             else:
                 raise self.error(
-                    lineno, f"unexpected text {text!r} outside any section"
+                    lineno,
+                    f"unexpected text {text!r} outside any section"
+                    + bvh_hint(tokens[0]),
                 )
         self._check_closed(block)
         return self._arguments()
@@ -122,16 +128,23 @@ class _AsfParser:
         if key == "begin":
             if block is not None:
                 raise self.error(lineno, "'begin' inside a bone block (missing 'end')")
-            return {"line": lineno, "dof": [], "axis": [0.0] * 3, "axis_order": "xyz"}
+            return {"line": lineno}
         if block is None:
             raise self.error(lineno, f"{tokens[0]!r} outside a begin/end bone block")
         if key == "end":
             self._finish_bone(lineno, block)
             return None
+        if key in _ONCE_PER_BONE and key in block:
+            raise self.error(
+                lineno,
+                f"a second {key!r} line in the bone block starting on line "
+                f"{block['line']}; a bone has one",
+            )
         if key == "name":
             block["name"] = tokens[1] if len(tokens) > 1 else ""
         elif key == "direction":
             block["direction"] = self._three_floats(lineno, tokens, "direction")
+            block["direction_line"] = lineno
         elif key == "length":
             if len(tokens) != 2:
                 raise self.error(lineno, "expected one number after 'length'")
@@ -153,21 +166,25 @@ class _AsfParser:
         for key in ("name", "direction", "length"):
             if key not in block or block[key] == "":
                 raise self.error(block["line"], f"bone block has no '{key}'")
-        if block["name"] == "root" or any(
-            b["name"] == block["name"] for b in self.bones
-        ):
+        if block["name"] in self.names:
             raise self.error(
                 block["line"], f"bone name {block['name']!r} is used twice"
             )
+        if not any(block["direction"]) and block["length"] != 0:
+            raise self.error(
+                block["direction_line"],
+                f"bone {block['name']!r} has direction 0 0 0 but length "
+                f"{format_number(block['length'])}; give the direction it points in",
+            )
+        self.names.add(block["name"])
         self.bones.append(block)
 
     def _hierarchy_line(self, lineno, tokens):
         if tokens[0].lower() in ("begin", "end"):
             return
         parent, children = tokens[0], tokens[1:]
-        known = {"root"} | {b["name"] for b in self.bones}
         for name in [parent, *children]:
-            if name not in known:
+            if name not in self.names:
                 raise self.error(lineno, f"unknown bone {name!r} in :hierarchy")
         for child in children:
             if child in self.parents:
@@ -217,6 +234,7 @@ class _AsfParser:
 
     def _bone(self, block):
         name = block["name"]
+        dof = block.get("dof", [])
         if name not in self.parents:
             raise self.error(
                 block["line"], f"bone {name!r} has no parent in :hierarchy"
@@ -226,10 +244,10 @@ class _AsfParser:
             parent=self.parents[name],
             direction=block["direction"],
             length=block["length"],
-            channels=tuple(block["dof"]),
-            rotation_order="".join(c[1] for c in block["dof"] if c in EULER_CHANNELS),
-            axis=self._to_degrees(block["axis"]),
-            axis_order=block["axis_order"],
+            channels=tuple(dof),
+            rotation_order="".join(c[1] for c in dof if c in EULER_CHANNELS),
+            axis=self._to_degrees(block.get("axis", [0.0] * 3)),
+            axis_order=block.get("axis_order", "xyz"),
         )
 
     def _checked(self, lineno, make_bone, *args):
@@ -267,16 +285,28 @@ class _AsfParser:
 
 
 def _parents_first(bones):
-    """Reorder bones so parents come first, keeping file order otherwise."""
-    ordered, placed, pending = [], set(), list(bones)
-    while pending:
-        ready = [b for b in pending if b.parent is None or b.parent in placed]
-        if not ready:
-            raise ValueError(
-                f"Bones {[b.name for b in pending]} are not connected to the root."
-            )
-        first = ready[0]
-        ordered.append(first)
-        placed.add(first.name)
-        pending.remove(first)
+    """Reorder bones so parents come first, keeping file order otherwise.
+
+    Always the earliest bone in file order whose parent is placed: a heap of
+    the file positions of the bones that are ready, in time linear in the
+    number of bones (up to the heap's logarithm).
+    """
+    waiting = defaultdict(list)
+    ready = []
+    for i, bone in enumerate(bones):
+        if bone.parent is None:
+            ready.append(i)
+        else:
+            waiting[bone.parent].append(i)
+    heapq.heapify(ready)
+    ordered = []
+    while ready:
+        bone = bones[heapq.heappop(ready)]
+        ordered.append(bone)
+        for i in waiting.pop(bone.name, ()):
+            heapq.heappush(ready, i)
+    if len(ordered) < len(bones):
+        placed = {bone.name for bone in ordered}
+        pending = [bone.name for bone in bones if bone.name not in placed]
+        raise ValueError(f"Bones {pending} are not connected to the root.")
     return ordered

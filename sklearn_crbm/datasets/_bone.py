@@ -1,5 +1,6 @@
 """One bone (or joint) of a skeleton: its place, length and channels."""
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -130,7 +131,7 @@ def _vector3(value, name, what):
         raise ValueError(
             f"Bone {name!r}: {what} must be three numbers, got shape {vector.shape}."
         )
-    if not np.all(np.isfinite(vector)):
+    if not all(map(math.isfinite, vector.flat)):
         raise ValueError(f"Bone {name!r}: {what} must be finite, got {vector}.")
     return vector.reshape(3)
 
@@ -149,11 +150,7 @@ def _finite_number(value, name, what):
 
 def _norm(vector):
     """Euclidean norm without overflow for huge components (e.g. 1e300)."""
-    scale = np.max(np.abs(vector))
-    if scale == 0:
-        return 0.0
-    with np.errstate(over="ignore"):
-        return float(scale * np.linalg.norm(vector / scale))
+    return math.hypot(*vector.tolist())
 
 
 def _check_bone_channels(bone):

@@ -4,10 +4,15 @@ import numpy as np
 
 from ..utils._rotations import matrix_to_euler
 from ._bone import Bone
-from ._bvh_hierarchy import CHANNEL_TO_BVH, parse_bvh_hierarchy, split_header
+from ._bvh_hierarchy import (
+    CHANNEL_TO_BVH,
+    END_SITE_SUFFIX,
+    parse_bvh_hierarchy,
+    split_header,
+)
 from ._channels import EULER_CHANNELS, TRANSLATION_CHANNELS
 from ._frame_rate import check_rate
-from ._parsing import format_number, parse_error, parse_floats
+from ._parsing import check_bone_names, format_number, parse_error, parse_floats
 from ._skeleton import Skeleton
 from ._up_axis import UP_AXIS_COMMENT, declared_up_axis, settle_up_axis
 
@@ -100,6 +105,9 @@ def _labelled_number(path, lines, k, label, end_line):
 
 
 def _parse_rows(path, rows, n_channels, n_frames, last_line):
+    if n_channels == 0 and not rows:
+        # every frame line is empty, and blank lines are not counted
+        return np.empty((n_frames, 0))
     if len(rows) < n_frames:
         raise parse_error(
             path,
@@ -125,11 +133,24 @@ def _parse_rows(path, rows, n_channels, n_frames, last_line):
 
 
 # ------------------------------------------------------------------ writing
-def write_bvh(path, data, skeleton, frame_rate, feature_names=None, *, root=None):
+def write_bvh(
+    path,
+    data,
+    skeleton,
+    frame_rate,
+    feature_names=None,
+    *,
+    root=None,
+    channels="portable",
+):
     """Write motion as a BVH file for animation tools.
 
     The file opens in Blender, pybvh, bvhio and bvhtoolbox, and their joint
-    positions are those of ``skeleton.forward_kinematics(data)``.  Every
+    positions are those of ``skeleton.forward_kinematics(data)``.  With
+    ``channels="source"`` a skeleton read from a BVH file keeps its own
+    channels (six per joint in the Bandai Namco files, any order and number
+    of rotation channels), and :func:`read_bvh` gives back exactly ``data``
+    and the skeleton.  With ``channels="portable"`` (the default) every
     joint has three rotation channels (Blender's importer reads no other
     number): a bone of a BVH skeleton, or of an ASF skeleton without
     ``axis`` pre-rotation, keeps its Euler channels and values (angles in
@@ -178,14 +199,20 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None, *, root=None
         a moving hip joint, such as the Bandai Namco files:
         ``root="Hips"`` gives a file that every BVH tool reads, with the
         same positions for every joint it keeps.  None: the skeleton's root.
+    channels : {"portable", "source"}, default="portable"
+        ``"portable"``: the layout described above, which every BVH tool
+        reads.  ``"source"``: the skeleton's own channels, in its order, each
+        joint's values as they are in ``data`` (BVH skeletons only; not with
+        ``root=``), for tools that expect the layout of the original file.
 
     Raises
     ------
     ValueError
-        If a channel of the skeleton is missing, a value is not finite, or
-        the skeleton cannot be written as BVH (several roots, translation
-        channels on an ASF bone other than the root, ``root=`` not a joint
-        of a BVH skeleton).
+        If a channel of the skeleton is missing, a value is not finite, a
+        bone name is not one word, or the skeleton cannot be written as BVH
+        (several roots, translation channels on an ASF bone other than the
+        root, ``root=`` not a joint of a BVH skeleton, ``channels="source"``
+        for a skeleton not read from a BVH file).
 
     Examples
     --------
@@ -202,6 +229,9 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None, *, root=None
             "or Skeleton.from_bvh."
         )
     frame_rate = check_rate(frame_rate, "frame_rate")
+    if channels not in ("portable", "source"):
+        raise ValueError(f"channels must be 'portable' or 'source', got {channels!r}.")
+    check_bone_names(skeleton.bone_names, "BVH")
     _check_writable(skeleton)
     X, columns = skeleton._columns(data, feature_names)
     if not np.all(
@@ -211,6 +241,33 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None, *, root=None
             "data contain NaN or infinite values; fill them before writing."
         )
     names = skeleton.feature_names if feature_names is None else feature_names
+    try:
+        if channels == "source":
+            joints, values = _source_layout(skeleton, X, columns, root)
+        else:
+            joints, values, skeleton = _portable_layout(
+                skeleton, X, names, columns, root
+            )
+        lines = ["HIERARCHY " + UP_AXIS_COMMENT.format(axis=skeleton.up_axis)]
+        _hierarchy_lines(skeleton, joints, skeleton.bones[0].name, 0, lines)
+    except RecursionError:
+        raise ValueError(
+            f"The skeleton nests {len(skeleton.bones)} bones too deeply to be "
+            "written as a BVH file."
+        ) from None
+    lines += [
+        "MOTION",
+        f"Frames: {X.shape[0]}",
+        f"Frame Time: {format_number(1.0 / frame_rate)}",
+    ]
+    lines += [" ".join(format_number(v) for v in row) for row in values]
+    with open(path, "w", encoding="utf-8") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def _portable_layout(skeleton, X, names, columns, root):
+    """``(joints, values, skeleton)`` of a file every BVH tool reads: three
+    rotation channels per joint (see :func:`write_bvh`)."""
     if root is not None and root != skeleton.bones[0].name:
         skeleton, X, names = _rerooted(skeleton, X, names, root)
         columns = {name: i for i, name in enumerate(names)}
@@ -220,27 +277,50 @@ def write_bvh(path, data, skeleton, frame_rate, feature_names=None, *, root=None
         "rotations": skeleton.local_rotations(X, names),
         "offsets": skeleton.local_offsets(X, names),
     }
-    try:
-        joints = _bvh_joints(skeleton, motion["offsets"])
-        lines = ["HIERARCHY " + UP_AXIS_COMMENT.format(axis=skeleton.up_axis)]
-        _hierarchy_lines(skeleton, joints, skeleton.bones[0].name, 0, lines)
-    except RecursionError:
-        raise ValueError(
-            f"The skeleton nests {len(skeleton.bones)} bones too deeply to be "
-            "written as a BVH file."
-        ) from None
+    joints = _bvh_joints(skeleton, motion["offsets"])
     values = np.column_stack(
         [_joint_values(skeleton, joint, motion) for joint in joints.values()]
         or [np.empty((X.shape[0], 0))]
     )
-    lines += [
-        "MOTION",
-        f"Frames: {X.shape[0]}",
-        f"Frame Time: {format_number(1.0 / frame_rate)}",
-    ]
-    lines += [" ".join(format_number(v) for v in row) for row in values]
-    with open(path, "w", encoding="utf-8") as f:
-        f.write("\n".join(lines) + "\n")
+    return joints, values, skeleton
+
+
+def _source_layout(skeleton, X, columns, root):
+    """``(joints, values)`` of a file with the skeleton's own channels."""
+    if root not in (None, skeleton.bones[0].name):
+        raise ValueError(
+            "root= rewrites the channels of the new root; it cannot be combined "
+            "with channels='source'."
+        )
+    kinds = set(EULER_CHANNELS + TRANSLATION_CHANNELS)
+    if skeleton.convention != "bvh" or any(
+        c not in kinds for bone in skeleton.bones for c in bone.channels
+    ):
+        raise ValueError(
+            "channels='source' writes the channels of a skeleton read from a BVH "
+            f"file; {skeleton!r} has {skeleton.convention!r} bones or channels BVH "
+            "does not have (exponential maps, offsets). Use channels='portable'."
+        )
+    joints = {}
+    for bone in skeleton.bones:
+        if _is_end_site(skeleton, bone):
+            joints[bone.parent]["end"] = bone.offset
+        else:
+            joints[bone.name] = {"offset": bone.offset, "channels": bone.channels}
+            joints[bone.name].setdefault("end", None)
+    joints = _depth_first(skeleton, joints)
+    order = [f"{name}_{c}" for name, j in joints.items() for c in j["channels"]]
+    return joints, X[:, [columns[name] for name in order]]
+
+
+def _is_end_site(skeleton, bone):
+    """Whether the bone is what :func:`read_bvh` makes of an End Site."""
+    return (
+        bone.parent is not None
+        and not bone.channels
+        and bone.name == bone.parent + END_SITE_SUFFIX
+        and not skeleton.children(bone.name)
+    )
 
 
 def _check_writable(skeleton):

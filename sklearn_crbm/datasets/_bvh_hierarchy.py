@@ -4,6 +4,7 @@ The parser gives the keyword arguments of :class:`Skeleton` (its bones and
 settings), so that it needs the bones alone and not the skeleton class.
 """
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,12 @@ _BVH_TO_CHANNEL = {
 }
 CHANNEL_TO_BVH = {v: k for k, v in _BVH_TO_CHANNEL.items()}
 END_SITE_SUFFIX = "_end"
+OTHER_FORMAT_HINTS = {
+    ".amc": "; this is an Acclaim AMC file: read it with read_amc(path, skeleton), "
+    "the skeleton from Skeleton.from_asf(its ASF file)",
+    ".asf": "; this is an Acclaim ASF skeleton file: read the motion of its AMC "
+    "files with read_amc(amc_path, Skeleton.from_asf(this file))",
+}
 
 
 class _Tokens:
@@ -90,11 +97,16 @@ def _parse_joint(tokens, parent, bones, names):
         raise tokens.error(f"joint name {name!r} is used twice", lineno)
     names.add(name)
     tokens.expect("{")
-    offset, channels, index = None, (), len(bones)
+    offset, channels, index = None, None, len(bones)
     bones.append(None)  # placeholder: children come after their parent
     while True:
         lineno, word = tokens.next("'}'")
         key = word.upper()
+        if key in ("OFFSET", "CHANNELS"):
+            if (offset if key == "OFFSET" else channels) is not None:
+                raise tokens.error(
+                    f"a second {key} line in joint {name!r}; a joint has one", lineno
+                )
         if key == "OFFSET":
             offset = np.array(tokens.floats(3, "OFFSET value"))
         elif key == "CHANNELS":
@@ -117,7 +129,7 @@ def _parse_joint(tokens, parent, bones, names):
             raise tokens.error(f"unexpected {word!r} in joint {name!r}", lineno)
     if offset is None:
         raise tokens.error(f"joint {name!r} has no OFFSET", lineno)
-    bones[index] = _checked_bone(tokens, lineno, name, parent, offset, channels)
+    bones[index] = _checked_bone(tokens, lineno, name, parent, offset, channels or ())
 
 
 def _checked_bone(tokens, lineno, *args):
@@ -163,7 +175,10 @@ def split_header(path):
         if text.strip().upper().startswith("MOTION"):
             return lines[:i], lines[i:]
     lineno = lines[-1][0] if lines else 1
-    raise parse_error(path, lineno, "no 'MOTION' section before the end of the file")
+    hint = OTHER_FORMAT_HINTS.get(Path(os.fspath(path)).suffix.lower(), "")
+    raise parse_error(
+        path, lineno, f"no 'MOTION' section before the end of the file{hint}"
+    )
 
 
 def parse_bvh_hierarchy(path, header=None):

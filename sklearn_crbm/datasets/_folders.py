@@ -8,8 +8,9 @@ from sklearn.utils import Bunch
 
 from ..utils._sequences import remember_sequences
 from ._acclaim import read_amc
+from ._agreement import check_agreement
 from ._bvh import read_bvh
-from ._frame_rate import RATIO_TOLERANCE, check_rate, kept_frames
+from ._frame_rate import check_rate, kept_frames
 from ._labels import file_labels
 from ._skeleton import Skeleton
 
@@ -23,9 +24,18 @@ def read_bvh_folder(
 
     Each file is one sequence, named by its path relative to ``folder``
     without the suffix; files are read in sorted order.  All files must
-    have the same channels (the same joints and channel order), as trials
-    of one capture set do.  With ``labels``, each file also has a label (a
-    style, an actor...), given to each of its frames in ``target``.
+    have the same skeleton (the same joints, parents and channel order) and
+    stand along the same up axis, as trials of one capture set do.  With
+    ``labels``, each file also has a label (a style, an actor...), given to
+    each of its frames in ``target``.
+
+    The joint that carries the body's travel (the first whose position
+    channels change) should be the same in every file.  A file whose travel
+    is carried by a joint above the one most files travel with (in one
+    Bandai Namco file the ground joint ``joint_Root`` travels while its
+    ``Hips`` stay) is rewritten: the joints above are set as still as in the
+    other files and the travel moved into that joint, every joint below it
+    in the same place, with a warning that names the file.
 
     Parameters
     ----------
@@ -58,7 +68,11 @@ def read_bvh_folder(
         must be among them.  ``None``: for a JSON key, the file
         ``{key}_label.txt`` in ``folder`` or in ``folder/../cfg`` when there
         is one (the Bandai Namco repository's ``style_label.txt``), else the
-        distinct labels in sorted order.
+        distinct labels in sorted order.  Without label names the labels must
+        be of one kind (all names, all integers, all booleans or all
+        floats): ``true``, ``1`` and ``1.0`` are one value to Python and
+        would merge into one class, so a mix is refused.  NaN is never a
+        label.
 
     Returns
     -------
@@ -93,9 +107,19 @@ def read_bvh_folder(
         If ``folder`` is not a folder or has no file matching ``pattern``, or
         a JSON label file is missing.
     ValueError
-        If a file is malformed, the files' channels differ, their frame
-        rates differ and ``frame_rate`` is None, or a file's label is missing
-        or not among ``label_names``.
+        If a file is malformed, the files' skeletons or up axes differ,
+        their frame rates differ and ``frame_rate`` is None, a file's travel
+        cannot be moved into the joint most files travel with, a file's
+        label is missing, not a finite value or not among ``label_names``.
+        The message names the file.
+    TypeError
+        If a label is not a single name or number, or the labels mix kinds
+        (``true``, ``1`` and ``1.0`` would merge into one class).
+
+    Warns
+    -----
+    UserWarning
+        When a file's travel is moved into another joint (see above).
 
     Examples
     --------
@@ -175,7 +199,7 @@ def read_amc_folder(
         If ``folder`` is not a folder, has no file matching ``pattern``, or
         an AMC file has no ASF file to go with it.
     ValueError
-        If a file is malformed or the files' channels differ.
+        If a file is malformed, or the files' skeletons or up axes differ.
 
     Examples
     --------
@@ -212,6 +236,12 @@ def _matching_files(folder, pattern):
     folder = Path(folder)
     if not folder.is_dir():
         raise FileNotFoundError(f"{folder} is not a folder.")
+    if not isinstance(pattern, str) or not pattern or Path(pattern).is_absolute():
+        raise ValueError(
+            f"pattern must be a non-empty pattern relative to the folder, such as "
+            f"'*.bvh' or '**/*.bvh', got {pattern!r}; to read another folder, "
+            "pass it as folder."
+        )
     paths = sorted(p for p in folder.glob(pattern) if p.is_file())
     if not paths:
         raise FileNotFoundError(f"No file in {folder} matches {pattern!r}.")
@@ -250,25 +280,10 @@ def _with_labels(bunch, folder, paths, labels, label_names):
 
 def _long_format(folder, sequences, frame_rate, kind):
     """The Bunch of :func:`read_bvh_folder` from ``(path, skeleton, data, rate)``."""
-    first_path, first_skeleton = sequences[0][:2]
-    for path, skeleton, _, _ in sequences[1:]:
-        if list(skeleton.feature_names) != list(first_skeleton.feature_names):
-            differ = sorted(
-                set(skeleton.feature_names) ^ set(first_skeleton.feature_names)
-            )
-            raise ValueError(
-                f"{path} and {first_path} have different channels "
-                f"({differ[:6] or 'the same ones in another order'}); read "
-                "files of different skeletons separately."
-            )
-    rates = [rate for _, _, _, rate in sequences]
+    sequences = check_agreement(sequences, frame_rate)
+    first_skeleton = sequences[0][1]
     if frame_rate is None:
-        frame_rate = rates[0]
-        if any(abs(rate - frame_rate) > RATIO_TOLERANCE * frame_rate for rate in rates):
-            raise ValueError(
-                f"The files have different frame rates {sorted(set(rates))}; pass "
-                "frame_rate= to bring them to a common rate by dropping frames."
-            )
+        frame_rate = sequences[0][3]
         kept = [data for _, _, data, _ in sequences]
     else:
         frame_rate = check_rate(frame_rate, "frame_rate")

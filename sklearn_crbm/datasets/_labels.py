@@ -9,9 +9,10 @@ turns either into integer codes and label names.
 """
 
 import json
+import math
 import os
 import re
-from numbers import Integral
+from numbers import Integral, Real
 from pathlib import Path
 
 import numpy as np
@@ -45,12 +46,15 @@ def file_labels(folder, paths, labels, label_names=None):
         The label names.
     """
     if isinstance(labels, str):
+        sources = [path.with_suffix(".json").name for path in paths]
         values = [_json_label(path, labels) for path in paths]
         if label_names is None:
             label_names = _label_name_file(folder, labels)
     elif isinstance(labels, re.Pattern):
+        sources = [path.name for path in paths]
         values = [_name_label(folder, path, labels) for path in paths]
     elif callable(labels):
+        sources = [f"{path.name} (labels= function)" for path in paths]
         values = [labels(path) for path in paths]
     else:
         raise TypeError(
@@ -58,9 +62,52 @@ def file_labels(folder, paths, labels, label_names=None):
             "a compiled regular expression matched against each file's name, or a "
             f"function of the file's path; got {type(labels).__name__} {labels!r}."
         )
+    values = [
+        _checked_label(v, source) for v, source in zip(values, sources, strict=True)
+    ]
     if label_names is None:
+        _check_one_kind(values, sources)
         return _codes_of_distinct_values(values)
     return _codes_of_named_values(values, _read_names(label_names), paths)
+
+
+def _checked_label(value, source):
+    """``value`` (a numpy scalar as the Python value), or an error naming
+    ``source`` if it is not a single name or finite number."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if not isinstance(value, str | Real):
+        raise TypeError(
+            f"{source}: every label must be a single value (a name or a number); "
+            f"got {type(value).__name__} {value!r:.80}."
+        )
+    if isinstance(value, Real) and not math.isfinite(value):
+        raise ValueError(
+            f"{source}: the label is {value!r}; NaN and infinity are not labels "
+            "(a missing label?). Give every file a name or a finite number."
+        )
+    return value
+
+
+def _kind(value):
+    return type(value).__name__ if isinstance(value, bool | float | str) else "int"
+
+
+def _check_one_kind(values, sources):
+    """A TypeError when the labels mix kinds: ``true``, ``1`` and ``1.0`` are
+    one value to Python and would merge into one class, and a number beside
+    a name is probably a mistake too."""
+    first = {}
+    for value, source in zip(values, sources, strict=True):
+        first.setdefault(_kind(value), (value, source))
+    if len(first) > 1:
+        (a, source_a), (b, source_b) = list(first.values())[:2]
+        raise TypeError(
+            f"The labels are not all of the same kind: {source_a} gives {a!r} "
+            f"({_kind(a)}) but {source_b} gives {b!r} ({_kind(b)}). True, 1 and 1.0 "
+            "would merge into one class; write every label the same way (e.g. "
+            "all names), or give label_names and integer indices into them."
+        )
 
 
 def _json_label(path, key):
@@ -74,8 +121,14 @@ def _json_label(path, key):
             f"{key!r} reads the label from a JSON file of the same name. Give "
             "labels as a regular expression or a function of the path instead."
         ) from None
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{json_path} is not valid JSON: {exc}.") from exc
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{json_path} is not UTF-8 text: {exc}.") from None
+    except RecursionError:
+        raise ValueError(
+            f"{json_path} is not a label file: its JSON is nested too deeply."
+        ) from None
+    except ValueError as exc:  # JSONDecodeError, or an integer of too many digits
+        raise ValueError(f"{json_path} is not valid JSON: {exc}.") from None
     if not isinstance(content, dict) or key not in content:
         found = sorted(content) if isinstance(content, dict) else type(content).__name__
         raise ValueError(f"{json_path} has no key {key!r}; it has {found}.")
@@ -103,7 +156,13 @@ def _label_name_file(folder, key):
 
 def _read_names(label_names):
     if isinstance(label_names, str | os.PathLike):
-        text = Path(label_names).read_text(encoding="utf-8")
+        try:
+            text = Path(label_names).read_text(encoding="utf-8")
+        except UnicodeDecodeError as exc:
+            raise ValueError(
+                f"{label_names} is not UTF-8 text: {exc}; label_names reads one "
+                "name a line."
+            ) from None
         names = [line.strip() for line in text.splitlines() if line.strip()]
     else:
         names = list(label_names)

@@ -4,6 +4,8 @@ import math
 import os
 
 __all__ = [
+    "bvh_hint",
+    "check_bone_names",
     "format_number",
     "load_mat_variables",
     "parse_error",
@@ -15,6 +17,40 @@ __all__ = [
 def parse_error(path, lineno, message):
     """A ``ValueError`` whose message starts with ``"{path}, line {lineno}: "``."""
     return ValueError(f"{os.fspath(path)}, line {lineno}: {message}")
+
+
+def bvh_hint(word):
+    """What to tell a user who gave a BVH file to an Acclaim reader, whose
+    first word is ``word``: nothing unless it is ``HIERARCHY``."""
+    if word.upper() != "HIERARCHY":
+        return ""
+    return "; this is a BVH file: read it with read_bvh(path)"
+
+
+def check_bone_names(names, file_format):
+    """A ValueError for the first name its file format's reader would refuse.
+
+    Names are single words: no whitespace (a line break would even start a
+    new line of the file), not empty.  In BVH a name cannot be a brace; in
+    AMC, where a line is a bone's name and its values, a name cannot start a
+    header (``:``) or a comment (``#``), nor be a frame number.
+    """
+    for name in names:
+        problem = None
+        if not name or any(c.isspace() or not c.isprintable() for c in name):
+            problem = "is empty or holds whitespace or unprintable characters"
+        elif file_format == "BVH" and name in ("{", "}"):
+            problem = "is a brace"
+        elif file_format == "AMC" and (
+            name.startswith(":") or "#" in name or name.lstrip("-").isdigit()
+        ):
+            problem = "starts with ':', holds '#' or is a number"
+        if problem is not None:
+            raise ValueError(
+                f"Cannot write the bone name {name!r} to a {file_format} file: it "
+                f"{problem}, so the file could not be read back. Build the "
+                "skeleton with a one-word name for that bone."
+            )
 
 
 def read_lines(path):

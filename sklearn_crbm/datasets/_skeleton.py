@@ -113,6 +113,9 @@ class Skeleton:
         self.convention = str(convention).lower()
         self._check()
         self._index = {bone.name: i for i, bone in enumerate(self.bones)}
+        self._children = {}
+        for bone in self.bones:
+            self._children.setdefault(bone.parent, []).append(bone.name)
 
     def _check(self):
         if self.up_axis not in ("x", "y", "z"):
@@ -183,7 +186,7 @@ class Skeleton:
     def children(self, name):
         """Names of the bones whose parent is ``name``."""
         self.bone(name)
-        return [bone.name for bone in self.bones if bone.parent == name]
+        return list(self._children.get(name, ()))
 
     def descendants(self, name):
         """``name`` and every bone below it, parents before children.
@@ -193,9 +196,11 @@ class Skeleton:
         """
         self.bone(name)
         found = [name]
-        for bone in self.bones:
-            if bone.parent in found:
+        below = {name}
+        for bone in self.bones[self._index[name] + 1 :]:
+            if bone.parent in below:
                 found.append(bone.name)
+                below.add(bone.name)
         return found
 
     @property
@@ -292,9 +297,7 @@ class Skeleton:
         bone would carry.  Same parameters as :meth:`forward_kinematics`.
         """
         X, columns = self._columns(data, feature_names)
-        return np.stack(
-            [self._local_rotation(bone, X, columns) for bone in self.bones], axis=1
-        )
+        return self._local_rotations(X, columns)
 
     def local_offsets(self, data, feature_names=None):
         """Offset of every bone from its parent, per frame, (n_frames, n_bones, 3).
@@ -307,34 +310,37 @@ class Skeleton:
         :meth:`forward_kinematics`.
         """
         X, columns = self._columns(data, feature_names)
-        return np.stack(
-            [self._local_offset(bone, X, columns) for bone in self.bones], axis=1
-        )
+        return self._local_offsets(X, columns)
 
     def _global_transforms(self, data, feature_names):
+        """Global positions and rotations, one depth of the tree at a time."""
         X, columns = self._columns(data, feature_names)
-        n_frames, n_bones = X.shape[0], len(self.bones)
-        positions = np.empty((n_frames, n_bones, 3))
-        rotations = np.empty((n_frames, n_bones, 3, 3))
-        for i, (bone, parent) in enumerate(
-            zip(self.bones, self.parent_indices, strict=True)
-        ):
-            local = self._local_rotation(bone, X, columns)
-            offset = self._local_offset(bone, X, columns)
-            if parent < 0:
-                rotations[:, i] = local
-                positions[:, i] = offset
+        local = self._local_rotations(X, columns)
+        offsets = self._local_offsets(X, columns)
+        rotations = np.empty_like(local)
+        positions = np.empty_like(offsets)
+        for depth, bones in enumerate(self._depth_levels()):
+            if depth == 0:
+                rotations[:, bones] = local[:, bones]
+                positions[:, bones] = offsets[:, bones]
                 continue
-            rotations[:, i] = rotations[:, parent] @ local
-            frame = (
-                rotations[:, i]
-                if self.convention == "acclaim"
-                else rotations[:, parent]
-            )
-            positions[:, i] = positions[:, parent] + np.einsum(
-                "nij,nj->ni", frame, offset
+            parents = self.parent_indices[bones]
+            rotations[:, bones] = rotations[:, parents] @ local[:, bones]
+            frame = rotations[:, bones if self.convention == "acclaim" else parents]
+            positions[:, bones] = positions[:, parents] + np.einsum(
+                "nkij,nkj->nki", frame, offsets[:, bones]
             )
         return positions, rotations
+
+    def _depth_levels(self):
+        """Indices of the bones at each depth below the roots (roots first)."""
+        depth = []
+        for parent in self.parent_indices:
+            depth.append(0 if parent < 0 else depth[parent] + 1)
+        levels = [[] for _ in range(max(depth) + 1)]
+        for i, d in enumerate(depth):
+            levels[d].append(i)
+        return [np.array(level, dtype=np.intp) for level in levels]
 
     def _required_channels(self):
         """Feature names that forward kinematics reads (all but MIT offsets)."""
@@ -349,46 +355,58 @@ class Skeleton:
         names = self.feature_names if feature_names is None else feature_names
         return frame_columns(data, names, self._required_channels())
 
-    def _angles(self, X, columns, bone, channel_names):
-        cols = [columns[f"{bone.name}_{c}"] for c in channel_names]
-        return X[:, cols]
-
-    def _local_rotation(self, bone, X, columns):
-        n_frames = X.shape[0]
-        kind = bone.rotation_type
-        if kind == "euler":
-            angles = self._angles(
-                X, columns, bone, [f"r{a}" for a in bone.rotation_order]
-            )
+    def _local_rotations(self, X, columns):
+        """Rotation of every bone relative to its parent, ``C @ M @ C^-1``
+        (see the module docstring), bones of one kind of channels together."""
+        n_frames, n_bones = X.shape[0], len(self.bones)
+        rotations = np.broadcast_to(np.eye(3), (n_frames, n_bones, 3, 3)).copy()
+        groups = {}
+        for i, bone in enumerate(self.bones):
+            kind = bone.rotation_type
+            if kind:
+                groups.setdefault((kind, bone.rotation_order), []).append(i)
+        for (kind, order), bones in groups.items():
+            names = [f"r{a}" for a in order] if kind == "euler" else EXPMAP_CHANNELS
+            angles = X[
+                :,
+                [[columns[f"{self.bones[i].name}_{c}"] for c in names] for i in bones],
+            ]
+            if kind == "expmap":
+                rotations[:, bones] = expmap_to_matrix(angles)
+                continue
             if self.angle_unit == "deg":
                 angles = np.deg2rad(angles)
-            M = euler_to_matrix(angles, bone.rotation_order)
-        elif kind == "expmap":
-            M = expmap_to_matrix(self._angles(X, columns, bone, EXPMAP_CHANNELS))
-        else:
-            M = np.broadcast_to(np.eye(3), (n_frames, 3, 3))
-        if np.any(bone.axis):
-            C = euler_to_matrix(np.deg2rad(bone.axis), bone.axis_order)
-            M = C @ M @ C.T
-        return M
+            rotations[:, bones] = euler_to_matrix(angles, order)
+        axes = {}
+        for i, bone in enumerate(self.bones):
+            if np.any(bone.axis):
+                axes.setdefault(bone.axis_order, []).append(i)
+        for order, bones in axes.items():
+            C = euler_to_matrix(np.deg2rad([self.bones[i].axis for i in bones]), order)
+            rotations[:, bones] = C @ rotations[:, bones] @ C.swapaxes(-1, -2)
+        return rotations
 
-    def _local_offset(self, bone, X, columns):
-        """Where the bone starts (BVH: the joint) relative to its parent, per frame.
+    def _local_offsets(self, X, columns):
+        """Where every bone starts (BVH: the joint) relative to its parent, per
+        frame.
 
         BVH position channels *replace* the matching components of the
         offset, as every BVH tool reads them (pybvh, bvhio, bvhtoolbox,
         Blender); ASF translation channels are *added* to the offset (for an
         ASF root, to its ``position``), as in the Acclaim format.
         """
-        offset = np.tile(bone.offset, (X.shape[0], 1))
-        for k, c in enumerate(TRANSLATION_CHANNELS):
-            if c in bone.channels:
+        rest = np.array([bone.offset for bone in self.bones]).reshape(-1, 3)
+        offsets = np.broadcast_to(rest, (X.shape[0], *rest.shape)).copy()
+        for i, bone in enumerate(self.bones):
+            for k, c in enumerate(TRANSLATION_CHANNELS):
+                if c not in bone.channels:
+                    continue
                 values = X[:, columns[f"{bone.name}_{c}"]]
                 if self.convention == "bvh":
-                    offset[:, k] = values
+                    offsets[:, i, k] = values
                 else:
-                    offset[:, k] += values
-        return offset
+                    offsets[:, i, k] += values
+        return offsets
 
     # ------------------------------------------------------------ constructors
     @classmethod

@@ -93,18 +93,20 @@ def _branching_bone(skeleton):
 
 def _branch_spread(skeleton, positions, hub):
     """Per frame and axis, how far apart the centroids of ``hub``'s branches lie."""
-    names = skeleton.bone_names
-    origin = positions[:, names.index(hub)]
-    centroids = np.stack(
-        [
-            positions[:, [names.index(b) for b in skeleton.descendants(child)]].mean(
-                axis=1
-            )
-            - origin
-            for child in skeleton.children(hub)
-        ],
-        axis=1,
-    )
+    index = {name: i for i, name in enumerate(skeleton.bone_names)}
+    branch = {child: k for k, child in enumerate(skeleton.children(hub))}
+    members = []  # (bone index, branch) of every bone below the hub
+    for bone in skeleton.bones[index[hub] + 1 :]:
+        if bone.name not in branch and bone.parent in branch:
+            branch[bone.name] = branch[bone.parent]
+        if bone.name in branch:
+            members.append((index[bone.name], branch[bone.name]))
+    bones, groups = np.array(members).T
+    n_branches = groups.max() + 1
+    sums = np.zeros((len(positions), n_branches, 3))
+    np.add.at(sums, (slice(None), groups), positions[:, bones])
+    counts = np.bincount(groups, minlength=n_branches)[None, :, None]
+    centroids = sums / counts - positions[:, index[hub]][:, None]
     return centroids.max(axis=1) - centroids.min(axis=1)
 
 

@@ -1,6 +1,7 @@
 """Global root <-> body-centred, ground-plane-invariant root."""
 
 import warnings
+from collections import Counter
 
 import numpy as np
 from sklearn.base import BaseEstimator, TransformerMixin, _fit_context
@@ -80,6 +81,33 @@ def _outputs(channels, up):
     return [c for c in _ROOT_OUT if given[c]]
 
 
+def _travels(names, X, bone):
+    """Whether the bone's translation channels change in ``X``."""
+    columns = [i for i, n in enumerate(names) if n in {f"{bone}_t{a}" for a in "xyz"}]
+    return len(columns) == 3 and np.ptp(X[:, columns], axis=0).max() > 0
+
+
+def _most_common_root(travelling):
+    """The root most sequences travel with (``(sequence, root)`` pairs); a
+    warning names the others."""
+    counts = Counter(root for _, root in travelling)
+    root, count = counts.most_common(1)[0]
+    odd = [(k, r) for k, r in travelling if r != root]
+    shown = ", ".join(f"{r!r} in sequence {k}" for k, r in odd[:5])
+    more = f" and {len(odd) - 5} more" if len(odd) > 5 else ""
+    warnings.warn(
+        f"The body travels with {shown}{more}, but with {root!r} in {count} of "
+        f"the {len(travelling)} sequences that travel: {root!r} is encoded as the "
+        "root, and in "
+        "those sequences the travel passes through as ordinary channels. Read "
+        "the files with read_bvh_folder, which moves the travel into the joint "
+        "most files travel with, or pass root=.",
+        UserWarning,
+        stacklevel=5,
+    )
+    return root
+
+
 class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
     """Make the root invariant to ground-plane translation and heading.
 
@@ -151,6 +179,9 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         skeleton's root (its first bone), except in rigs that put a static
         bone above the moving pelvis (the Bandai Namco files: ``joint_Root``
         above ``Hips``); ``"root"`` for a plain array without a skeleton.
+        Sequences (``sequence_ids``) that travel with different bones give
+        the bone most of them travel with, and a warning that names the
+        others.
     roll : {"euler", "taylor"}, default="euler"
         ``"euler"`` gives every orientation, upside down included, an exact
         inverse.  ``"taylor"`` reproduces Taylor's ``preprocess1`` (the
@@ -277,14 +308,25 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         self.roll = roll
         self.channels = channels
 
-    def _root_name(self, names, X):
+    def _root_name(self, names, X, sequences):
         if self.root is not None:
             return self.root
         if names is None:
             return "root"
         if self.skeleton is not None:
             check_skeleton(self.skeleton)
-        return moving_root(names, X, self.skeleton) or "root"
+        roots = [
+            moving_root(names, X[start:stop], self.skeleton)
+            for start, stop in zip(sequences.starts, sequences.stops, strict=True)
+        ]
+        travelling = [
+            (k, root)
+            for k, root in enumerate(roots)
+            if _travels(names, X[sequences.starts[k] : sequences.stops[k]], root)
+        ]
+        if len({root for _, root in travelling}) < 2:
+            return moving_root(names, X, self.skeleton) or "root"
+        return _most_common_root(travelling)
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None, *, sequence_ids=None):
@@ -306,7 +348,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             The fitted encoder.
         """
         X = validate_data(self, X, dtype=np.float64, ensure_all_finite="allow-nan")
-        check_sequence_ids(sequence_ids, X.shape[0])
+        sequences = check_sequence_ids(sequence_ids, X.shape[0])
         up = self.up_axis
         if up is None:
             up = getattr(self.skeleton, "up_axis", None) or "y"
@@ -320,7 +362,7 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
             expmap_feature_names,
             "the skeleton's channels, after ExpMapEncoder, are {}",
         )
-        root = self._root_name(names, X)
+        root = self._root_name(names, X, sequences)
         wanted = [f"{root}_{c}" for c in channels]
         if names is None:
             if X.shape[1] < len(channels):

@@ -275,6 +275,14 @@ MALFORMED = {
     "number in motion": ("1 2 4 90", "1 2 4 9O", 29, "'9O'"),
     "more frames than announced": ("Frames: 2", "Frames: 1", 29, "more frames"),
     "no motion": ("MOTION", "MOTOR", 29, "'MOTION'"),
+    "second offset": (
+        "OFFSET 0 10 0\n", "OFFSET 0 10 0\n    OFFSET 0 9 0\n", 9,
+        "a second OFFSET line in joint 'Spine'",
+    ),
+    "second channels": (
+        "CHANNELS 1 Xrotation\n", "CHANNELS 1 Xrotation\n    CHANNELS 0\n", 19,
+        "a second CHANNELS line in joint 'Leg'",
+    ),
 }  # fmt: skip
 
 

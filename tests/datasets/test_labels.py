@@ -189,7 +189,7 @@ def test_labels_errors(styles_folder, tmp_path):
     with pytest.raises(ValueError, match="pass labels= too"):
         read_bvh_folder(tmp_path, label_names=["a"])
     write_bvh(tmp_path / "walk_b.bvh", walker.data, walker.skeleton, 30.0)
-    with pytest.raises(TypeError, match="do not sort together.*give label_names"):
+    with pytest.raises(TypeError, match="not all of the same kind.*give label_names"):
         read_bvh_folder(tmp_path, labels=lambda p: 1 if p.stem == "walk_a" else "b")
 
 

@@ -1,18 +1,33 @@
-"""Fuzzing the file readers: they raise nothing but ValueError on bad files.
+"""Fuzzing the file readers: only ValueError or TypeError on bad files.
 
-Real files (CMU subject 35's ASF and AMC, and a BVH written from them) are
-mutated by hypothesis: truncated, bytes flipped, lines deleted, duplicated or
-swapped, garbage tokens inserted or substituted.  A reader must either reject
-the result with a ValueError (or, for undecodable paths, an OSError) or
-return well-formed, finite data; any other exception is a bug in the reader.
+Real files (CMU subject 35's ASF and AMC, and a BVH written from them; from
+the development set a Bandai Namco BVH with six channels on every joint and
+the CMU backflip's ASF and AMC) are mutated by hypothesis: truncated, bytes
+flipped, lines deleted, duplicated or swapped, garbage tokens inserted or
+substituted.  A reader must either reject the result with a ValueError (a
+TypeError for a label that is not a value; an OSError for undecodable paths)
+or return well-formed, finite data; any other exception is a bug in the
+reader.  The label readers get mutated JSON label files, label-name files,
+JSON values of every kind and label functions returning anything.
 """
+
+import json
+import math
+import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from sklearn_crbm.datasets import Skeleton, read_amc, read_bvh, write_bvh
+from sklearn_crbm.datasets import (
+    Skeleton,
+    make_walker,
+    read_amc,
+    read_bvh,
+    read_bvh_folder,
+    write_bvh,
+)
 from sklearn_crbm.utils import check_sequence_ids
 
 SETTINGS = dict(
@@ -100,6 +115,26 @@ def originals(real_files, tmp_path_factory):
     }
 
 
+@pytest.fixture(scope="module")
+def dev_originals(data_home):
+    """The first three frames of a Bandai Namco BVH file (six channels on each
+    of 22 joints) and of the CMU backflip's AMC, with its ASF."""
+    dev = data_home / "external_dev"
+    bandai = (dev / "bandai_namco" / "dataset-2_run_active_001.bvh").read_bytes()
+    head, _, motion = bandai.partition(b"MOTION")
+    lines = motion.strip().split(b"\n")
+    bvh = b"\n".join([head + b"MOTION", b"Frames: 3", lines[1], *lines[2:5], b""])
+    asf = dev / "cmu_asfamc_gsimchoni" / "backflip.asf"
+    amc = (dev / "cmu_asfamc_gsimchoni" / "backflip.amc").read_bytes().split(b"\n")
+    starts = [i for i, line in enumerate(amc) if line.strip() == b"4"]
+    return {
+        "skeleton": Skeleton.from_asf(asf),
+        "asf": asf.read_bytes(),
+        "amc": b"\n".join(amc[: starts[0]]) + b"\n",
+        "bvh": bvh,
+    }
+
+
 def _check_skeleton(skeleton):
     assert isinstance(skeleton, Skeleton)
     for bone in skeleton.bones:
@@ -133,7 +168,7 @@ def _fuzz(kind, content, originals, tmp_path):
     path.write_bytes(content)
     try:
         _read(kind, path, originals["skeleton"])
-    except ValueError as exc:
+    except (ValueError, TypeError) as exc:
         # a clear message: it names the file (and the line) or the problem
         assert str(exc)
 
@@ -173,6 +208,100 @@ def test_random_bytes_raise_only_value_errors(kind, content, originals, tmp_path
 def test_token_soup_raises_only_value_errors(kind, lines, originals, tmp_path):
     content = b"\n".join(b" ".join(words) for words in lines)
     _fuzz(kind, content, originals, tmp_path)
+
+
+@pytest.mark.parametrize("kind", READERS)
+@settings(max_examples=40, **SETTINGS)
+@given(data=st.data())
+def test_mutated_development_files_raise_only_value_errors(
+    kind, data, dev_originals, tmp_path
+):
+    content = data.draw(mutated(dev_originals[kind.split("-")[0]]))
+    _fuzz(kind, content, dev_originals, tmp_path)
+
+
+# ----------------------------------------------------------------- labels
+@pytest.fixture(scope="module")
+def labelled_folder(tmp_path_factory):
+    """Two small BVH files with JSON labels and label names beside them."""
+    folder = tmp_path_factory.mktemp("labelled")
+    walker = make_walker(n_sequences=1, n_frames=2, random_state=0)
+    for name in ("walk_a", "walk_b"):
+        write_bvh(folder / f"{name}.bvh", walker.data, walker.skeleton, 30.0)
+    return folder
+
+
+LABEL_JSON = b'{"content": 0, "style": 1}'
+LABEL_NAMES = b"active\nelderly\nnormal\n"
+json_values = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=4),
+    lambda inner: (
+        st.lists(inner, max_size=3)
+        | st.dictionaries(st.text(max_size=3), inner, max_size=3)
+    ),
+    max_leaves=6,
+)
+
+
+def _read_labels(folder, json_a, names=None, n_classes=None, **params):
+    (folder / "walk_a.json").write_bytes(json_a)
+    (folder / "walk_b.json").write_bytes(LABEL_JSON)
+    names_file = folder / "style_label.txt"
+    names_file.unlink(missing_ok=True)
+    if names is not None:
+        names_file.write_bytes(names)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            walks = read_bvh_folder(folder, **{"labels": "style", **params})
+    except (ValueError, TypeError) as exc:
+        assert str(exc)
+        return
+    assert walks.target.shape == (4,)
+    assert 0 <= walks.target.min() and walks.target.max() < len(walks.target_names)
+    for name in walks.target_names:
+        assert not (isinstance(name, float) and math.isnan(name))
+    if n_classes is not None:
+        assert len(np.unique(walks.target)) == n_classes
+
+
+@settings(max_examples=60, **SETTINGS)
+@given(data=st.data())
+def test_mutated_label_files_raise_only_value_or_type_errors(data, labelled_folder):
+    if data.draw(st.booleans()):
+        _read_labels(labelled_folder, data.draw(mutated(LABEL_JSON)), LABEL_NAMES)
+    else:
+        _read_labels(labelled_folder, LABEL_JSON, data.draw(mutated(LABEL_NAMES)))
+
+
+@settings(max_examples=60, **SETTINGS)
+@given(value=json_values, named=st.booleans())
+@example(value=float("nan"), named=False)
+@example(value=True, named=False)
+@example(value=1.0, named=False)
+def test_any_json_label_raises_only_value_or_type_errors(value, named, labelled_folder):
+    # beside walk_b's label 1, an accepted label is a class of its own unless
+    # it is the integer 1
+    content = json.dumps({"style": value}).encode()
+    same = type(value) is int and value == 1
+    _read_labels(
+        labelled_folder,
+        content,
+        LABEL_NAMES if named else None,
+        n_classes=None if named else 1 if same else 2,
+    )
+
+
+@settings(max_examples=40, **SETTINGS)
+@given(value=json_values | st.binary(max_size=3) | st.tuples(st.integers()))
+def test_label_functions_returning_anything_raise_only_value_or_type_errors(
+    value, labelled_folder
+):
+    _read_labels(
+        labelled_folder,
+        LABEL_JSON,
+        labels=lambda path: value if path.stem == "walk_a" else "b",
+    )
 
 
 def test_deeply_nested_bvh_is_a_value_error(tmp_path):
