@@ -3,7 +3,9 @@
 A scikit-learn compatible implementation of Taylor, Hinton & Roweis,
 "Modeling Human Motion Using Binary Latent Variables" (NIPS 2006): the
 conditional RBM and its two-level stack, the paper's motion-capture
-preprocessing, on-line filling in of missing channels, and generation.
+preprocessing, on-line filling in of missing channels, and generation; and
+models of many styles in one (the factored CRBM of Taylor & Hinton, ICML
+2009, and a CRBM whose biases take the style labels).
 """
 
 from . import datasets, metrics, model_selection, plotting, preprocessing

@@ -1,4 +1,10 @@
-"""What ConditionalRBM and StackedCRBM share: inference, scoring, generation."""
+"""What every model of the package shares: inference, scoring, generation.
+
+:class:`BaseCRBM` is the base of :class:`~sklearn_crbm.ConditionalRBM`,
+:class:`~sklearn_crbm.StackedCRBM` and, through
+:class:`~sklearn_crbm._base_layer.BaseLayerModel`, of the style models
+:class:`~sklearn_crbm.FactoredCRBM` and :class:`~sklearn_crbm.LabelledCRBM`.
+"""
 
 from abc import ABCMeta, abstractmethod
 from numbers import Integral, Real

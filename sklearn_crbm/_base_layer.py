@@ -1,4 +1,9 @@
-"""What ConditionalRBM and FactoredCRBM share: one conditional layer, trained by CD."""
+"""What the one-layer models share: one conditional layer, trained by CD.
+
+:class:`BaseLayerModel` is the base of :class:`~sklearn_crbm.ConditionalRBM`
+and, through :class:`~sklearn_crbm._style_model.BaseStyleModel`, of
+:class:`~sklearn_crbm.FactoredCRBM` and :class:`~sklearn_crbm.LabelledCRBM`.
+"""
 
 import math
 from abc import abstractmethod
@@ -85,8 +90,11 @@ class BaseLayerModel(BaseCRBM):
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
+        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
+            The style of every frame, for the models that take one (required
+            by :class:`~sklearn_crbm.FactoredCRBM` and
+            :class:`~sklearn_crbm.LabelledCRBM`: a label per frame, or label
+            weights per frame); ignored by :class:`~sklearn_crbm.ConditionalRBM`.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
 
@@ -124,8 +132,11 @@ class BaseLayerModel(BaseCRBM):
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
+        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
+            The style of every frame, for the models that take one (required
+            by :class:`~sklearn_crbm.FactoredCRBM` and
+            :class:`~sklearn_crbm.LabelledCRBM`: a label per frame, or label
+            weights per frame); ignored by :class:`~sklearn_crbm.ConditionalRBM`.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
 

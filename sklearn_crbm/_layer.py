@@ -29,6 +29,9 @@ trainable arrays in one flat buffer) with
     A callable like ``frame_rbms`` for a model that does not change while
     it is used (generation, fill-in), which may keep what does not depend
     on the frame.
+``product_size()``
+    Multiply-adds per frame of the layer's largest matrix product (the
+    default: its largest weight matrix), which sizes the BLAS threads.
 ``new_workspace(batch_size)`` and ``cd_statistics(visible, history,
 context, cd_steps, rng, *, out, scale, workspace)``
     Training: the contrastive-divergence statistics of a minibatch, each
@@ -296,6 +299,15 @@ class ConditionalLayer(PackedParameters):
     def conditioner(self):
         """``frame_rbms`` for a model that stays as it is while it is used."""
         return self.frame_rbms
+
+    def product_size(self):
+        """Multiply-adds per frame of the layer's largest matrix product.
+
+        The size of its largest weight matrix (every weight matrix multiplies
+        a batch of frames, one row per frame); the package sizes its BLAS
+        threads by it (:mod:`sklearn_crbm.utils._threads`).
+        """
+        return max(math.prod(shape) for shape in self._shapes() if len(shape) == 2)
 
     def new_workspace(self, batch_size):
         return TrainingWorkspace(self, batch_size)

@@ -1,7 +1,9 @@
 """Advancing sequences frame by frame from their own past: generation and fill-in.
 
-:meth:`ConditionalRBM.sample`, :meth:`StackedCRBM.sample` and
-:class:`~sklearn_crbm.impute.CRBMImputer` all call :func:`run_online`, with
+Every model's ``sample`` (:class:`~sklearn_crbm.ConditionalRBM`,
+:class:`~sklearn_crbm.StackedCRBM`, :class:`~sklearn_crbm.FactoredCRBM`,
+:class:`~sklearn_crbm.LabelledCRBM`) and
+:class:`~sklearn_crbm.impute.CRBMImputer` call :func:`run_online`, with
 one layer or a stack, of any kind (:mod:`sklearn_crbm._layer`):
 
 - generation: nothing observed, every frame of every sequence drawn from a

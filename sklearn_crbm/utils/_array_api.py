@@ -17,7 +17,6 @@ Random numbers follow the same split: the math draws from a
 PyTorch; numpy draws moved to the device for other namespaces) otherwise.
 """
 
-import contextlib
 import functools
 from numbers import Real
 
@@ -124,9 +123,6 @@ class ArrayOps:
     def arange(self, *args, dtype=None):
         return self.xp.arange(*args, dtype=dtype, device=self.device)
 
-    def linspace(self, start, stop, num):
-        return self.asarray(np.linspace(start, stop, num), dtype=self.xp.float64)
-
     def empty_like(self, x, dtype=None):
         return self.xp.empty_like(x, dtype=dtype)
 
@@ -184,9 +180,6 @@ class ArrayOps:
 
     def negative(self, x, out=None):
         return self._into(out, -x)
-
-    def reciprocal(self, x, out=None):
-        return self._into(out, 1 / x)
 
     def less(self, a, b, out=None):
         result = a < b
@@ -247,9 +240,6 @@ class ArrayOps:
 
     def finfo(self, dtype):
         return self.xp.finfo(dtype)
-
-    def errstate(self, **kwargs):
-        return contextlib.nullcontext()
 
 
 def _ops_named(name, device):

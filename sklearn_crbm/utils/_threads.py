@@ -107,9 +107,9 @@ def limit_blas_threads(rows):
     rows : callable
         ``rows(estimator, *args, **kwargs)`` with the method's arguments:
         the number of rows of one matrix product in the method's loop.  The
-        product's size is that times the model's width (hidden units times
-        visible and past inputs).  Errors count as a small product: the method
-        itself reports bad input.
+        product's size is that times the multiply-adds per row of the model's
+        largest product (see :func:`_width`).  Errors count as a small
+        product: the method itself reports bad input.
 
     Returns
     -------
@@ -143,12 +143,18 @@ def _n_features(estimator, args):
 
 
 def _width(estimator, n_features):
-    """Hidden units times inputs of the model's largest layer."""
+    """Multiply-adds per row of the largest matrix product of the model's layers.
+
+    A fitted model asks its layers
+    (:meth:`~sklearn_crbm._layer.ConditionalLayer.product_size`); before the
+    first fit, the widest layer its parameters ask for: hidden units times
+    the visible and past inputs.
+    """
     model = getattr(estimator, "estimator_", estimator)
+    if hasattr(model, "n_features_in_"):
+        return max(layer.product_size() for layer in model._layers())
     sizes = [int(s) for s in np.ravel(model.n_components)]
-    order = model.order
-    hidden_order = order if model.hidden_order is None else model.hidden_order
-    inputs = max([n_features, *sizes[:-1]]) * (1 + max(order, hidden_order))
+    inputs = max([n_features, *sizes[:-1]]) * (1 + model._n_lags)
     return max(sizes) * inputs
 
 

@@ -7,11 +7,20 @@ import pytest
 from threadpoolctl import ThreadpoolController, threadpool_limits
 
 import sklearn_crbm
-from sklearn_crbm import ConditionalRBM, CRBMImputer, StackedCRBM
+from sklearn_crbm import (
+    ConditionalRBM,
+    CRBMImputer,
+    FactoredCRBM,
+    LabelledCRBM,
+    StackedCRBM,
+)
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.utils._threads import (
     MIN_WORK_PER_THREAD,
+    _product_size,
     auto_blas_threads,
+    batch_rows,
+    frame_rows,
     limit_blas_threads,
 )
 
@@ -34,7 +43,7 @@ def two_threads():
 class Recorder:
     """A stand-in estimator whose method notes the BLAS threads it runs with."""
 
-    order, hidden_order, batch_size = 3, None, 100
+    _n_lags, batch_size = 3, 100
 
     def __init__(self, n_components):
         self.n_components = n_components
@@ -110,6 +119,66 @@ def test_nested_and_concurrent_calls_restore_the_count(two_threads):
         )
     for filled in results:
         np.testing.assert_array_equal(filled, results[0])
+    assert min(blas_threads()) == two_threads
+
+
+def _small_models():
+    yield ConditionalRBM(5, order=2, n_iter=1, random_state=0)
+    yield StackedCRBM((5, 3), order=2, n_iter=1, random_state=0)
+    yield FactoredCRBM(
+        5, n_factors=4, n_style_features=2, order=2, n_iter=1, random_state=0
+    )
+    yield LabelledCRBM(5, order=2, n_iter=1, random_state=0)
+
+
+@pytest.mark.parametrize("model", _small_models(), ids=lambda m: type(m).__name__)
+def test_every_model_has_a_work_estimate(model):
+    """Before and after fit, the product size is the layers' (never 0)."""
+    X, ids = make_oscillations(n_sequences=2, n_frames=30, n_features=4, random_state=0)
+    y = ids if isinstance(model, FactoredCRBM | LabelledCRBM) else None
+    before = _product_size(batch_rows, model, (X, y), {})
+    assert before >= model.batch_size * 4 * 5
+    model.fit(X, y, sequence_ids=ids)
+    largest = max(layer.product_size() for layer in model._layers())
+    assert _product_size(batch_rows, model, (X, y), {}) == model.batch_size * largest
+    assert _product_size(frame_rows, model, (X,), {}) == len(X) * largest
+    imputer = CRBMImputer(model).fit(X, y, sequence_ids=ids)
+    assert _product_size(lambda *a: 1, imputer, (X,), {}) == largest
+
+
+def test_layer_product_size_is_its_largest_weight_matrix():
+    X, ids = make_oscillations(n_sequences=2, n_frames=30, n_features=4, random_state=0)
+    crbm = ConditionalRBM(5, order=2, n_iter=1).fit(X, sequence_ids=ids)
+    assert crbm._layer.product_size() == (4 + 5) * (2 * 4)  # [A; B] on the past
+    factored = FactoredCRBM(5, n_factors=7, n_style_features=2, order=3, n_iter=1)
+    factored.fit(X, ids, sequence_ids=ids)
+    assert factored._layer.product_size() == 3 * 4 * 7  # the past to the factors
+
+
+def test_large_factored_model_trains_on_the_threads_allowed(two_threads, monkeypatch):
+    """FactoredCRBM has no hidden_order: its work was once estimated as 0."""
+    from sklearn_crbm._factored_layer import FactoredLayer
+
+    seen = []
+    original = FactoredLayer.cd_statistics
+
+    def spy(*args, **kwargs):
+        seen.append(min(blas_threads()))
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(FactoredLayer, "cd_statistics", spy)
+    X, ids = make_oscillations(
+        n_sequences=2, n_frames=520, n_features=100, random_state=0
+    )
+    # batch 1000 x 1000 hidden units x 200 factors: 2e8 multiply-adds
+    model = FactoredCRBM(
+        1000, n_factors=200, n_style_features=2, order=2, batch_size=1000, n_iter=1
+    )
+    assert _product_size(batch_rows, model, (X, ids), {}) > 2 * MIN_WORK_PER_THREAD
+    model.fit(X, ids, sequence_ids=ids)
+    model.partial_fit(X, ids, sequence_ids=ids)
+    assert _product_size(batch_rows, model, (X, ids), {}) >= 2 * MIN_WORK_PER_THREAD
+    assert seen and set(seen) == {two_threads}
     assert min(blas_threads()) == two_threads
 
 
