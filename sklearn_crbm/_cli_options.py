@@ -1,5 +1,6 @@
 """The command line's commands and their arguments (see :mod:`._cli`)."""
 
+import argparse
 import tempfile
 from pathlib import Path
 
@@ -14,6 +15,23 @@ DEMO_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_demo"
 STYLES_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_styles"
 # The model options default to the estimators' own defaults.
 _DEFAULTS = ConditionalRBM()
+
+
+def _epochs(text):
+    """``--n-iter``: a positive integer or ``auto``."""
+    if text == "auto":
+        return text
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(
+            f"expected a positive integer or auto, got {text!r}"
+        )
+    return value
+
+
 _FACTORED = FactoredCRBM()
 
 
@@ -57,7 +75,11 @@ _MODEL_OPTIONS = [
         "the last epoch's, the paper's schedule)",
     ),
     _option(
-        "--n-iter", type=int, default=1000, help="training epochs (the paper: 4000)"
+        "--n-iter",
+        type=_epochs,
+        default=_DEFAULTS.n_iter,
+        help="training epochs (the paper: 4000); auto: enough for 25,000 "
+        "minibatch updates, at least 1000",
     ),
     _SEED,
 ]
