@@ -8,13 +8,13 @@ models of many styles in one (the factored CRBM of Taylor & Hinton, ICML
 2009, and a CRBM whose biases take the style labels).
 """
 
-from . import datasets, metrics, model_selection, plotting, preprocessing
+from . import datasets, exceptions, metrics, model_selection, plotting, preprocessing
 from ._config import config_context, get_config, set_config
 from ._crbm import ConditionalRBM
 from ._factored import FactoredCRBM
 from ._labelled import LabelledCRBM
 from ._stacked import StackedCRBM
-from ._training import TrainingDivergedError
+from .exceptions import TrainingDivergedError
 from .impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from .preprocessing import (
     ExpMapEncoder,
@@ -40,6 +40,7 @@ __all__ = [
     "__version__",
     "config_context",
     "datasets",
+    "exceptions",
     "get_config",
     "make_motion_preprocessor",
     "metrics",

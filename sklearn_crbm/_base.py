@@ -6,6 +6,9 @@
 :class:`~sklearn_crbm.FactoredCRBM` and :class:`~sklearn_crbm.LabelledCRBM`.
 """
 
+import inspect
+import os
+import warnings
 from abc import ABCMeta, abstractmethod
 from numbers import Integral, Real
 
@@ -15,6 +18,7 @@ from sklearn.base import (
     ClassNamePrefixFeaturesOutMixin,
     TransformerMixin,
 )
+from sklearn.utils import Bunch
 from sklearn.utils._array_api import check_same_namespace, get_namespace
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import (
@@ -31,14 +35,16 @@ from ._likelihood import (
     stack_log_likelihood_bound,
 )
 from ._online import TOP_LAYER, History, run_online
-from .utils._array_api import array_ops, array_random, is_numpy
+from .exceptions import GenerationWarning
+from .metrics import motion_amplitude
+from .utils._array_api import array_ops, array_random, is_numpy, to_numpy
 from .utils._parallel import SAMPLE_BLOCK, map_sequence_blocks
 from .utils._persistence import VersionedPickleMixin
 from .utils._random import rng_from
 from .utils._sequences import check_sequence_ids
 from .utils._threads import frame_rows, limit_blas_threads, sequence_rows
 
-__all__ = ["BaseCRBM", "check_count", "seed_frames"]
+__all__ = ["BaseCRBM", "check_count", "generated_liveliness", "seed_frames"]
 
 # How many windows of training frames ``fit`` keeps to seed ``sample``.
 MAX_SEED_WINDOWS = 500
@@ -51,6 +57,14 @@ BOUND_SAMPLES = 10
 # Standard deviation of the jitter added to the previous frame to start the
 # Gibbs chain of a new frame (the original code's gen.m).
 START_JITTER = 0.01
+# ``sample`` judges the last frames of every generated sequence (more than a
+# cycle of walking or waving at 30 frames per second) against the same
+# number of last frames of every training sequence: moving less than
+# DEAD_FRACTION as much, it died out; beyond BLOWN_DEVIATIONS standard
+# deviations of the widest channel from the training mean, it blew up.
+LIVELINESS_FRAMES = 100
+DEAD_FRACTION = 0.5
+BLOWN_DEVIATIONS = 10.0
 
 
 class BaseCRBM(
@@ -85,7 +99,7 @@ class BaseCRBM(
         "batch_size": [Interval(Integral, 1, None, closed="left")],
         "batching": [StrOptions({"balanced", "shuffled"})],
         "history_noise": [Interval(Real, 0, None, closed="left")],
-        "n_iter": [Interval(Integral, 1, None, closed="left")],
+        "n_iter": [Interval(Integral, 1, None, closed="left"), StrOptions({"auto"})],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
     }
@@ -164,6 +178,21 @@ class BaseCRBM(
             X, sequence_ids=sequence_ids
         )
 
+    def _keep_seeds(self, X, sequences, merge=False):
+        """Keep windows of ``X`` to seed :meth:`sample`, and what it judges by.
+
+        Sets ``seed_windows_`` and ``generation_statistics_``; with
+        ``merge`` (``partial_fit``), joined to those of the earlier calls.
+        """
+        windows = self._pick_seed_windows(X, sequences)
+        statistics = generation_statistics(X, sequences)
+        if merge and hasattr(self, "seed_windows_"):
+            windows = self._merge_seed_windows(windows)
+        if merge and hasattr(self, "generation_statistics_"):
+            statistics = merge_statistics(self.generation_statistics_, statistics)
+        self.seed_windows_ = windows
+        self.generation_statistics_ = statistics
+
     def _pick_seed_windows(self, X, sequences):
         """Up to ``MAX_SEED_WINDOWS`` evenly spaced windows of real frames.
 
@@ -180,8 +209,6 @@ class BaseCRBM(
 
     def _merge_seed_windows(self, new):
         """Seed windows of a ``partial_fit`` call joined to the earlier ones."""
-        if not hasattr(self, "seed_windows_"):
-            return new
         ops = array_ops(new)
         windows = ops.concatenate((self.seed_windows_, new))
         picks = evenly_spaced(np.arange(windows.shape[0]), MAX_SEED_WINDOWS)
@@ -529,7 +556,7 @@ class BaseCRBM(
             seed_windows=self.seed_windows_,
             rng=rng,
         )
-        return self._generate(
+        frames = self._generate(
             seed,
             n_samples,
             rng,
@@ -538,6 +565,21 @@ class BaseCRBM(
             sample_visibles=sample_visibles,
             n_jobs=n_jobs,
         )
+        self._check_generated(frames, n_samples)
+        return frames
+
+    def _check_generated(self, frames, n_frames):
+        """Warn with a :class:`GenerationWarning` about sequences that died out
+        or blew up (a model fitted before ``generation_statistics_`` existed
+        is not judged)."""
+        statistics = getattr(self, "generation_statistics_", None)
+        if statistics is None:
+            return
+        # binary visibles stay within [0, 1]: only non-finite values blew up
+        scale = np.inf if self._layers()[0].binary else statistics.scale
+        message = lifeless_message(to_numpy(frames), n_frames, statistics, scale)
+        if message:
+            warnings.warn(message, GenerationWarning, stacklevel=_caller_level())
 
     def _generate(self, seed, n_samples, rng, *, context=None, n_jobs=None, **gibbs):
         """``n_samples`` frames after each seed, in long format (see :meth:`sample`).
@@ -677,6 +719,116 @@ def seed_frames(history, n_sequences, *, width, n_features, dtype, seed_windows,
     if not ops.all(ops.isfinite(history)):
         raise ValueError("history contains NaN or infinity.")
     return ops.ascontiguousarray(history[:, -width:, ...])
+
+
+def generation_statistics(X, sequences):
+    """What ``sample`` judges generated motion against, from the training data.
+
+    A :class:`~sklearn.utils.Bunch`: ``mean`` (every channel's mean),
+    ``scale`` (the largest channel standard deviation), ``amplitude`` (the
+    :func:`~sklearn_crbm.metrics.motion_amplitude` of the last
+    ``LIVELINESS_FRAMES`` frames of every sequence, their mean weighted by
+    those frames) and ``n_frames``.
+    """
+    X = to_numpy(X).astype(np.float64, copy=False)
+    amplitudes = motion_amplitude(
+        X, sequence_ids=sequences.per_frame_ids(), last_frames=LIVELINESS_FRAMES
+    )
+    weights = np.minimum(sequences.lengths, LIVELINESS_FRAMES)
+    return Bunch(
+        mean=X.mean(axis=0),
+        scale=float(X.std(axis=0).max()),
+        amplitude=float(np.average(amplitudes, weights=weights)),
+        n_frames=X.shape[0],
+    )
+
+
+def merge_statistics(old, new):
+    """The :func:`generation_statistics` of two calls of ``partial_fit``, joined."""
+    total = old.n_frames + new.n_frames
+    share = new.n_frames / total
+    return Bunch(
+        mean=old.mean + share * (new.mean - old.mean),
+        scale=max(old.scale, new.scale),
+        amplitude=old.amplitude + share * (new.amplitude - old.amplitude),
+        n_frames=total,
+    )
+
+
+def generated_liveliness(frames, n_frames, statistics):
+    """How much every generated sequence moves at its end, against training.
+
+    The amplitude (:func:`~sklearn_crbm.metrics.motion_amplitude`) of the
+    last ``LIVELINESS_FRAMES`` frames of every sequence of ``frames`` (long
+    format, ``n_frames`` each) over ``statistics.amplitude``: 1 moves as much
+    as the training sequences; NaN where fewer frames were generated.
+    """
+    n_sequences = len(frames) // n_frames
+    if n_frames < LIVELINESS_FRAMES or not statistics.amplitude > 0:
+        return np.full(n_sequences, np.nan)
+    amplitude = motion_amplitude(
+        np.nan_to_num(frames),  # what blew up is judged as blown, not here
+        sequence_ids=np.repeat(np.arange(n_sequences), n_frames),
+        last_frames=LIVELINESS_FRAMES,
+    )
+    return amplitude / statistics.amplitude
+
+
+def lifeless_message(frames, n_frames, statistics, scale=None):
+    """What went wrong with generated ``frames`` (long format), or "" if nothing.
+
+    A sequence blew up when a value is non-finite or more than
+    ``BLOWN_DEVIATIONS`` times ``scale`` (default ``statistics.scale``) from
+    the training mean;
+    it died out when its :func:`generated_liveliness` is below
+    ``DEAD_FRACTION`` (judged only when ``LIVELINESS_FRAMES`` frames or more
+    were generated).
+    """
+    sequences = frames.reshape(-1, n_frames, frames.shape[1])
+    with np.errstate(invalid="ignore", over="ignore"):
+        scale = statistics.scale if scale is None else scale
+        distance = np.abs(sequences - statistics.mean) / scale
+        reach = np.where(np.isfinite(distance), distance, np.inf).max(axis=(1, 2))
+    blown = np.flatnonzero(reach > BLOWN_DEVIATIONS)
+    liveliness = generated_liveliness(frames, n_frames, statistics)
+    dead = np.setdiff1d(np.flatnonzero(liveliness < DEAD_FRACTION), blown)
+    parts = []
+    if len(blown):
+        parts.append(
+            f"{_count(blown, len(sequences))} blew up (values up to "
+            f"{reach[blown].max():.3g} training standard deviations from the "
+            "training mean, or non-finite). Train longer (n_iter), lower "
+            "learning_rate, or seed with real frames (history=)."
+        )
+    if len(dead):
+        parts.append(
+            f"{_count(dead, len(sequences))} died out: over the last "
+            f"{LIVELINESS_FRAMES} frames, moving at most "
+            f"{liveliness[dead].max():.2f} times as much as the training "
+            f"sequences (below {DEAD_FRACTION}: the motion came to rest). "
+            "Train for more updates (raise n_iter) or on more frames, or seed "
+            "with real frames of the motion wanted (history=); see the user "
+            "guide's 'Training on your own corpus'."
+        )
+    return " ".join(parts)
+
+
+def _caller_level():
+    """The ``stacklevel`` that points a warning at the first caller outside the
+    package (through ``MotionPipeline.sample`` and the thread decorators)."""
+    package = os.path.dirname(os.path.abspath(__file__))
+    frame, level = inspect.currentframe().f_back, 1
+    while frame is not None and frame.f_code.co_filename.startswith(package):
+        frame, level = frame.f_back, level + 1
+    return level
+
+
+def _count(indices, n_sequences):
+    """``"Sequence 2 of 3"`` or ``"Sequences 0, 2 of 3"``."""
+    noun = "Sequence" if len(indices) == 1 else "Sequences"
+    listed = ", ".join(str(int(k)) for k in indices[:10])
+    more = ", ..." if len(indices) > 10 else ""
+    return f"{noun} {listed}{more} of {n_sequences}"
 
 
 def evenly_spaced(values, at_most):

@@ -31,6 +31,11 @@ from .utils._threads import batch_rows, limit_blas_threads
 
 __all__ = ["BaseLayerModel"]
 
+# ``n_iter="auto"``: at least AUTO_EPOCHS epochs, and enough of them for
+# AUTO_UPDATES minibatch updates (what 1000 epochs of 25 minibatches give:
+# CMU subject 35, 26-28 minibatches an epoch, trains 1000 epochs).
+AUTO_EPOCHS, AUTO_UPDATES = 1000, 25_000
+
 
 class BaseLayerModel(BaseCRBM):
     """Base class of the models that are one conditional layer trained by CD.
@@ -115,9 +120,10 @@ class BaseLayerModel(BaseCRBM):
                 self._train_with_early_stopping(X, sequences, context)
             else:
                 self._start_parameters(X, frames, context)
-                n_averaged = math.ceil(self.average_fraction * self.n_iter)
-                self._train(X, frames, self.n_iter, n_averaged, context)
-            self.seed_windows_ = self._pick_seed_windows(X, sequences)
+                n_epochs = self._n_epochs(len(frames))
+                n_averaged = math.ceil(self.average_fraction * n_epochs)
+                self._train(X, frames, n_epochs, n_averaged, context)
+            self._keep_seeds(X, sequences)
         return self
 
     @limit_blas_threads(batch_rows)
@@ -165,9 +171,7 @@ class BaseLayerModel(BaseCRBM):
                 self._initialize(X)
                 self._start_parameters(X, frames, context)
             self._train(X, frames, 1, context=context)
-        self.seed_windows_ = self._merge_seed_windows(
-            self._pick_seed_windows(X, sequences)
-        )
+        self._keep_seeds(X, sequences, merge=True)
         return self
 
     @property
@@ -182,6 +186,18 @@ class BaseLayerModel(BaseCRBM):
 
     def _layers(self):
         return [self._layer]
+
+    def _n_epochs(self, n_frames):
+        """The epochs ``fit`` trains on ``n_frames`` trainable frames.
+
+        ``n_iter``, or for ``"auto"`` enough epochs for ``AUTO_UPDATES``
+        minibatch updates, at least ``AUTO_EPOCHS``: a corpus of short takes
+        gets as many parameter updates as a larger one.
+        """
+        if self.n_iter != "auto":
+            return self.n_iter
+        batches_per_epoch = math.ceil(n_frames / self.batch_size)
+        return max(AUTO_EPOCHS, math.ceil(AUTO_UPDATES / batches_per_epoch))
 
     def _ais_settings(self):
         return self.ais_steps, self.ais_chains
@@ -267,8 +283,9 @@ class BaseLayerModel(BaseCRBM):
         seed = int(rng.integers(np.iinfo(np.int32).max))
         self.validation_scores_ = []
         best, best_iter, best_layer = -np.inf, 0, None
-        while self.n_iter_ < self.n_iter:
-            epochs = min(self.validation_interval, self.n_iter - self.n_iter_)
+        n_epochs = self._n_epochs(len(train_frames))
+        while self.n_iter_ < n_epochs:
+            epochs = min(self.validation_interval, n_epochs - self.n_iter_)
             self._train(X_train, train_frames, epochs, context=train_context)
             log_likelihood = self._log_likelihood(
                 X_valid, valid, rng=np.random.default_rng(seed), context=valid_context

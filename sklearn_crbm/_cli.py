@@ -17,8 +17,10 @@ import numpy as np
 import sklearn
 from sklearn.utils import Bunch
 
+from ._base import generated_liveliness
 from ._cli_options import COMMANDS, MAX_DEFAULT_RATE
 from ._crbm import ConditionalRBM
+from ._demo import liveliness_text
 from ._demo import run_demo as _run_demo
 from ._demo import save_gif
 from ._factored import FactoredCRBM
@@ -93,7 +95,7 @@ def _model_from_args(args):
         history_noise_fraction=args.history_noise_fraction,
         average_fraction=args.average_fraction,
         random_state=args.seed,
-        verbose=max(1, args.n_iter // 10),
+        verbose=max(1, (1000 if args.n_iter == "auto" else args.n_iter) // 10),
     )
 
 
@@ -293,12 +295,13 @@ def run_sample(args):
         random_state=args.seed,
     )
     suffixes = [".bvh"] + [".amc"] * (pipeline.skeleton.convention == "acclaim")
+    lively = _liveliness(pipeline, raw, args.n_frames)
     sequences = np.split(raw, args.n_sequences)
     for k, sequence in enumerate(sequences):
         for suffix in suffixes:
             path = Path(f"{args.output}_{k}{suffix}")
             pipeline.write_motion(path, sequence, frame_rate=saved.frame_rate)
-            print(f"wrote {path}")
+            print(f"wrote {path} ({liveliness_text(lively[k])})")
     if args.animate:
         path = save_gif(
             Path(f"{args.output}.gif"),
@@ -309,6 +312,16 @@ def run_sample(args):
         )
         print(f"wrote {path}")
     return 0
+
+
+def _liveliness(pipeline, raw, n_frames):
+    """:func:`generated_liveliness` of generated raw channels, per sequence."""
+    ids = np.repeat(np.arange(len(raw) // n_frames), n_frames)
+    Z = pipeline[:-1].transform(raw, sequence_ids=ids)
+    statistics = getattr(pipeline[-1], "generation_statistics_", None)
+    if statistics is None:  # saved by a version that kept no statistics
+        return np.full(ids[-1] + 1, np.nan)
+    return generated_liveliness(Z, n_frames, statistics)
 
 
 def _seeds(saved, args):

@@ -16,6 +16,13 @@ DEMO_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_demo"
 STYLES_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_styles"
 # The model options default to the estimators' own defaults.
 _DEFAULTS = ConditionalRBM()
+
+
+def _epochs(text):
+    """``--n-iter``: ``auto`` or a whole number of at least 1."""
+    return text if text == "auto" else _count(1)(text)
+
+
 _FACTORED = FactoredCRBM()
 
 
@@ -107,9 +114,10 @@ _MODEL_OPTIONS = [
     ),
     _option(
         "--n-iter",
-        type=_count(1),
-        default=1000,
-        help="training epochs (the paper: 4000)",
+        type=_epochs,
+        default=_DEFAULTS.n_iter,
+        help="training epochs (the paper: 4000); auto: enough for 25,000 "
+        "minibatch updates, at least 1000",
     ),
     _SEED,
 ]

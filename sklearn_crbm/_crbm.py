@@ -74,8 +74,14 @@ class ConditionalRBM(BaseLayerModel):
     average_fraction : float in [0, 1), default=0.25
         :meth:`fit` keeps the mean of the parameters over this fraction of
         its last epochs (Polyak-Ruppert averaging); ``0``: the last epoch's.
-    n_iter : int, default=1000
-        Number of epochs (passes over the trainable frames).
+    n_iter : int or "auto", default="auto"
+        Number of epochs (passes over the trainable frames).  ``"auto"``
+        depends on the data: enough epochs for 25,000 minibatch updates,
+        and at least 1000 (``ceil(25000 / ceil(n_trainable_frames /
+        batch_size))``): 1000 epochs for 2,500 frames or more, such as CMU
+        subject 35, more for smaller corpora, such as a dozen takes of
+        running, whose 1000 epochs would be too few updates for the
+        generated motion to stay alive.
     ais_steps : int, default=50
         Annealing steps of :meth:`score` where enumeration would cost more.
     ais_chains : int, default=2
@@ -187,7 +193,7 @@ class ConditionalRBM(BaseLayerModel):
         history_noise=1.0,
         history_noise_fraction=0.5,
         average_fraction=0.25,
-        n_iter=1000,
+        n_iter="auto",
         ais_steps=50,
         ais_chains=2,
         early_stopping=False,

@@ -11,6 +11,7 @@ import time
 import numpy as np
 from sklearn.impute import KNNImputer
 
+from ._base import DEAD_FRACTION, generated_liveliness
 from .datasets import write_amc, write_bvh
 from .impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from .metrics import judge_generated_motion
@@ -144,7 +145,9 @@ def _generate_styles(model, preprocessor, Z, train, args):
         "frames/s)\n"
         "  style        the nearest training style in speed and step frequency\n"
         "  verdict      keeps its style, or died out (legs still), stalled "
-        "(walking in place), blew up"
+        "(walking in place), blew up; lively: how much the last 100 frames move "
+        f"against the training sequences (1 = as much; below {DEAD_FRACTION} the "
+        "motion came to rest)"
     )
     print(f"{'seeded with':<12}{'speed':>8}{'step Hz':>9}   {'style':<7}verdict")
     rng = np.random.default_rng(args.seed)
@@ -173,10 +176,14 @@ def _generate_styles(model, preprocessor, Z, train, args):
             last_frames=JUDGED_FRAMES,
             **common,
         )
+        lively = generated_liveliness(
+            frames, args.n_frames, model.generation_statistics_
+        )
         for k in range(N_PER_STYLE):
             print(
                 f"{style:<12}{verdict.speed[k]:8.3f}{verdict.frequency[k]:9.2f}   "
-                f"{str(verdict.style[k]):<7}{_verdict_text(verdict, k)}"
+                f"{str(verdict.style[k]):<7}{_verdict_text(verdict, k)} "
+                f"({liveliness_text(lively[k])})"
             )
         generated[style] = (frames, gen_ids)
     real = judge_generated_motion(Z, Z, sequence_ids=ids, **common)
@@ -187,6 +194,14 @@ def _generate_styles(model, preprocessor, Z, train, args):
             f"{np.nanmean(real.frequency[mine]):9.2f}   (training mean)"
         )
     return generated
+
+
+def liveliness_text(liveliness):
+    """``"lively 0.93"``, or with ``": came to rest"`` below DEAD_FRACTION."""
+    if not np.isfinite(liveliness):
+        return "lively -"
+    rest = ": came to rest" if liveliness < DEAD_FRACTION else ""
+    return f"lively {liveliness:.2f}{rest}"
 
 
 def _verdict_text(verdict, k):

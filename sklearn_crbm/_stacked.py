@@ -315,7 +315,7 @@ class StackedCRBM(BaseCRBM):
             self.layers_.append(layer)
             if k + 1 < len(sizes):
                 data, ids = self._pass_up(layer, data, ids)
-        self.seed_windows_ = self._pick_seed_windows(X, sequences)
+        self._keep_seeds(X, sequences)
         return self
 
     @limit_blas_threads(batch_rows)
@@ -363,9 +363,7 @@ class StackedCRBM(BaseCRBM):
             layer.partial_fit(data, sequence_ids=ids)
             if k + 1 < len(self.layers_):
                 data, ids = self._pass_up(layer, data, ids)
-        self.seed_windows_ = self._merge_seed_windows(
-            self._pick_seed_windows(X, sequences)
-        )
+        self._keep_seeds(X, sequences, merge=True)
         return self
 
     def _layers(self):

@@ -218,11 +218,14 @@ def _print_blend(judge, judged, first, args):
     a, b = args.blend
     Z, ids = judged[f"blend_{a}_{b}"]
     verdict = judge.verdict(Z, sequence_ids=ids)
-    predicted = verdict.predicted[verdict.starts >= first]
+    kept = verdict.starts >= first
+    predicted = verdict.predicted[kept]
     shares = {style: np.mean(predicted == style) for style in (a, b)}
+    alive = np.mean(verdict.alive[kept])  # against the style each is judged as
     print(
         f"blend {a} + {b}: {sum(shares.values()):.0%} of the windows judged as "
-        f"one of the two ({a} {shares[a]:.0%}, {b} {shares[b]:.0%})"
+        f"one of the two ({a} {shares[a]:.0%}, {b} {shares[b]:.0%}); alive "
+        f"{alive:.0%}"
     )
 
 
@@ -235,7 +238,10 @@ def _print_transition(judge, judged, first, args):
     before = (verdict.starts >= first) & (verdict.starts + judge.window <= switch)
     after = verdict.starts >= switch
     before, after = (
-        f"{verdict.correct[windows].mean():.0%}" if windows.any() else "no window"
+        f"{verdict.correct[windows].mean():.0%} (alive "
+        f"{verdict.alive[windows].mean():.0%})"
+        if windows.any()
+        else "no window"
         for windows in (before, after)
     )
     print(

@@ -593,7 +593,7 @@ n_classes), default=None
         ops = array_ops(seed)
         context = self._as_context(weights, seed)
         context = ops.broadcast_to(context[None, ...], (seed.shape[0], *weights.shape))
-        return self._generate(
+        frames = self._generate(
             seed,
             n_frames,
             rng,
@@ -603,6 +603,8 @@ n_classes), default=None
             hidden_noise=hidden_noise,
             sample_visibles=False,
         )
+        self._check_generated(frames, n_frames)
+        return frames
 
     def __sklearn_array_api_convert__(self, converter):
         """A copy on another namespace or device whose labels stay on the host.

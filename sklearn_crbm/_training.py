@@ -26,6 +26,13 @@ __all__ = ["ProgressMonitor", "Schedule", "TrainingDivergedError", "train_epochs
 MONITOR_FRAMES = 1000
 # Mean-field iterations of those predictions.
 MONITOR_MEAN_FIELD_STEPS = 10
+ONE_STEP_EXPLANATION = (
+    "one-step error: RMS error per channel of predicting each training frame "
+    "from its past. A model that learns the motion predicts better than "
+    "repeating the previous frame; one that stays worse has not learnt how "
+    "the motion goes on, and its generated motion tends to die out: train "
+    "for more updates (n_iter) or on more frames."
+)
 
 
 class TrainingDivergedError(FloatingPointError):
@@ -117,11 +124,17 @@ class ProgressMonitor:
         return bool(self.verbose) and epoch % self.verbose == 0
 
     def report(self, epoch, layer, reconstruction_error):
-        """Print the line of ``epoch`` for the layer as it is after it."""
+        """Print the line of ``epoch`` for the layer as it is after it (the
+        first line says what the one-step error means)."""
+        if not hasattr(self, "_explained"):
+            self._explained = True
+            print(f"[{self.name}] {ONE_STEP_EXPLANATION}")
         error = self.one_step_error(layer)
+        verdict = "better" if error < self.previous_frame_error else "WORSE"
         print(
             f"[{self.name}] epoch {epoch}: one-step error {error:.4f} "
-            f"(previous frame: {self.previous_frame_error:.4f}), reconstruction "
+            f"({verdict} than repeating the previous frame: "
+            f"{self.previous_frame_error:.4f}), reconstruction "
             f"error {reconstruction_error:.4f}, time "
             f"{time.perf_counter() - self._start:.1f}s"
         )

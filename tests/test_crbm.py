@@ -564,21 +564,27 @@ def test_binary_visibles():
 def test_verbose_reports_progress(capsys):
     X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     ConditionalRBM(4, n_iter=4, verbose=2, random_state=0).fit(X, sequence_ids=ids)
-    lines = capsys.readouterr().out.strip().splitlines()
+    explanation, *lines = capsys.readouterr().out.strip().splitlines()
+    assert explanation.startswith("[ConditionalRBM] one-step error: RMS error")
+    assert "tends to die out" in explanation
     number = r"(\d+\.\d{4})"
     pattern = (
-        rf"\[ConditionalRBM\] epoch (\d+): one-step error {number} \(previous "
-        rf"frame: {number}\), reconstruction error {number}, time \d+\.\ds"
+        rf"\[ConditionalRBM\] epoch (\d+): one-step error {number} \((better|"
+        rf"WORSE) than repeating the previous frame: {number}\), reconstruction "
+        rf"error {number}, time \d+\.\ds"
     )
     matches = [re.fullmatch(pattern, line) for line in lines]
     assert len(lines) == 2 and all(matches), lines
     assert [int(match[1]) for match in matches] == [2, 4]
+    for match in matches:
+        better = float(match[2]) < float(match[4])
+        assert match[3] == ("better" if better else "WORSE")
     # repeating the previous frame: the RMS error of X[t - 1] for X[t] over
     # every trainable frame (those after the first order=3 of each sequence)
     frames = [t for t in range(3, len(X)) if ids[t - 3] == ids[t]]
     previous_frame = np.sqrt(np.mean(np.square(X[frames] - X[np.subtract(frames, 1)])))
     for match in matches:
-        assert float(match[3]) == pytest.approx(previous_frame, abs=1e-4)
+        assert float(match[4]) == pytest.approx(previous_frame, abs=1e-4)
 
 
 def test_divergence_raises_naming_the_learning_rate():

@@ -36,9 +36,9 @@ API_SECTIONS = [
     (
         "sklearn_crbm",
         "Models",
-        "The conditional RBM, its stack, the models of labelled styles, and "
-        "exceptions.",
+        "The conditional RBM, its stack and the models of labelled styles.",
     ),
+    ("sklearn_crbm.exceptions", "Warnings and errors", None),
     ("sklearn_crbm.impute", "Filling in missing channels", None),
     ("sklearn_crbm.preprocessing", "Motion preprocessing", None),
     ("sklearn_crbm.datasets", "Data sets, skeletons and mocap files", None),

@@ -8,8 +8,12 @@ move like it.
 
 from ._fillin import fillin_angle_rmse, fillin_error
 from ._generation import (
+    foot_skating,
     forward_speed,
     gait_statistics,
+    jitter,
+    liveliness,
+    most_moving_channels,
     motion_amplitude,
     nearest_style,
     spectral_similarity,
@@ -22,9 +26,13 @@ __all__ = [
     "StyleJudge",
     "fillin_angle_rmse",
     "fillin_error",
+    "foot_skating",
     "forward_speed",
     "gait_statistics",
+    "jitter",
     "judge_generated_motion",
+    "liveliness",
+    "most_moving_channels",
     "motion_amplitude",
     "nearest_style",
     "spectral_similarity",

@@ -31,6 +31,15 @@ class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
     unused exponential-map axes of one-degree-of-freedom joints, bone
     offsets and channels that never move carry no information.
 
+    A kept feature that barely moves is not blown up to unit variance: its
+    scale is at least ``scale_floor`` times the median standard deviation
+    of the kept features (the typical channel's).  Without that floor a toe
+    that stood still in the training takes gets a tiny scale, and the same
+    toe in a held-out take of the same motion lands hundreds of standard
+    deviations away, where no model trained on the z-scores can follow
+    (seeds of generation, fill-in); with it, such a feature's z-scores stay
+    small and its training variance below one.
+
     Parameters
     ----------
     copy : bool, default=True
@@ -46,6 +55,10 @@ class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         ``constant_tol * max(1, |mean|)``: a relative tolerance, so that
         rounding noise (about 1e-16 times the magnitude) counts as constant.
         None keeps every feature, as scikit-learn's scaler does.
+    scale_floor : float in [0, 1), default=0.01
+        Lower bound of every kept feature's scale, as a fraction of the
+        median standard deviation of the kept features; ``0`` scales every
+        feature to unit variance, as scikit-learn's scaler does.
 
     Attributes
     ----------
@@ -56,8 +69,9 @@ class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         Variance (ddof=0) of every input feature, always computed: it
         decides which features are constant.
     scale_ : ndarray of shape (`n_features_in_`,) or None
-        ``sqrt(var_)``, with 1 for constant features; None when
-        ``with_std=False``.
+        ``sqrt(var_)``, raised to the floor (``scale_floor`` times the median
+        of the kept features' ``sqrt(var_)``), with 1 for constant features;
+        None when ``with_std=False``.
     constant_mask_ : ndarray of bool of shape (`n_features_in_`,)
         True for the dropped (constant) features.
     n_samples_seen_ : int or ndarray of shape (`n_features_in_`,)
@@ -100,13 +114,23 @@ class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         "with_mean": ["boolean"],
         "with_std": ["boolean"],
         "constant_tol": [Interval(Real, 0, None, closed="left"), None],
+        "scale_floor": [Interval(Real, 0, 1, closed="left")],
     }
 
-    def __init__(self, *, copy=True, with_mean=True, with_std=True, constant_tol=1e-10):
+    def __init__(
+        self,
+        *,
+        copy=True,
+        with_mean=True,
+        with_std=True,
+        constant_tol=1e-10,
+        scale_floor=0.01,
+    ):
         self.copy = copy
         self.with_mean = with_mean
         self.with_std = with_std
         self.constant_tol = constant_tol
+        self.scale_floor = scale_floor
 
     def _reset(self):
         for attr in ("mean_", "var_", "scale_", "constant_mask_", "n_samples_seen_"):
@@ -178,13 +202,18 @@ class StandardScaler(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         else:
             bound = self.constant_tol * np.maximum(1.0, np.abs(self.mean_))
             self.constant_mask_ = ~(std > bound)  # NaN statistics count as constant
-        if self.with_std:
-            scale = std.copy()
-            scale[self.constant_mask_ | ~(scale > 0)] = 1.0
-            self.scale_ = scale
-        else:
-            self.scale_ = None
+        self.scale_ = self._scale(std) if self.with_std else None
         return self
+
+    def _scale(self, std):
+        """Every feature's scale: its standard deviation, at least the floor."""
+        kept = ~self.constant_mask_ & (std > 0)
+        scale = std.copy()
+        if self.scale_floor and kept.any():
+            floor = self.scale_floor * np.median(std[kept])
+            scale[kept] = np.maximum(scale[kept], floor)
+        scale[~kept] = 1.0
+        return scale
 
     def transform(self, X, copy=None):
         """Standardise the kept features.

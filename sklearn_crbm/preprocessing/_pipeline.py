@@ -448,6 +448,7 @@ def make_motion_preprocessor(
     with_mean=True,
     with_std=True,
     constant_tol=1e-10,
+    scale_floor=0.01,
 ):
     """The paper's preprocessing: exp maps, body-centred root, z-scores.
 
@@ -505,6 +506,11 @@ def make_motion_preprocessor(
     constant_tol : float or None, default=1e-10
         Passed to :class:`StandardScaler`: the tolerance below which a
         channel counts as constant and is dropped.
+    scale_floor : float, default=0.01
+        Passed to :class:`StandardScaler`: a channel that moves less than
+        this fraction of the typical channel is scaled as if it moved that
+        much, so that held-out takes of the same motion stay within the
+        range of the training data.
 
     Returns
     -------
@@ -556,7 +562,10 @@ def make_motion_preprocessor(
             (
                 "scale",
                 StandardScaler(
-                    with_mean=with_mean, with_std=with_std, constant_tol=constant_tol
+                    with_mean=with_mean,
+                    with_std=with_std,
+                    constant_tol=constant_tol,
+                    scale_floor=scale_floor,
                 ),
             ),
         ]

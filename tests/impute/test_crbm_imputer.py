@@ -280,7 +280,8 @@ def test_verbose_reports_training(capsys):
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].startswith("[CRBMImputer] training ConditionalRBM(")
     assert lines[0].endswith("on 40 complete frames in 2 sequences")
-    assert [line.split(":")[0] for line in lines[1:]] == [
+    assert lines[1].startswith("[ConditionalRBM] one-step error: RMS error")
+    assert [line.split(":")[0] for line in lines[2:]] == [
         "[ConditionalRBM] epoch 2",
         "[ConditionalRBM] epoch 4",
     ]

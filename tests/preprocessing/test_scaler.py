@@ -117,3 +117,35 @@ def test_a_single_frame_drops_every_channel_and_comes_back():
     assert Z.shape == (1, 0)
     assert np.array_equal(scaler.inverse_transform(Z), X)
     assert scaler.get_feature_names_out().shape == (0,)
+
+
+def test_scale_floor_is_a_fraction_of_the_median_scale():
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((200, 5)) * [1.0, 2.0, 3.0, 1e-6, 0.0]
+    scaler = StandardScaler(scale_floor=0.1).fit(X)
+    std = X.std(axis=0)
+    assert scaler.constant_mask_.tolist() == [False] * 3 + [False, True]
+    floor = 0.1 * np.median(std[:4])
+    assert np.allclose(scaler.scale_, [std[0], std[1], std[2], floor, 1.0])
+    Z = scaler.transform(X)
+    assert np.allclose(Z[:, :3].std(axis=0), 1.0)
+    assert Z[:, 3].std() < 1e-4
+    assert np.allclose(scaler.inverse_transform(Z)[:, :4], X[:, :4])
+
+
+def test_scale_floor_zero_gives_unit_variance_to_every_kept_feature():
+    rng = np.random.default_rng(0)
+    X = rng.standard_normal((200, 3)) * [1.0, 2.0, 1e-6]
+    Z = StandardScaler(scale_floor=0.0).fit_transform(X)
+    assert np.allclose(Z.std(axis=0), 1.0)
+
+
+def test_a_barely_moving_channel_keeps_held_out_motion_in_range():
+    # a toe that stood still in training moves a little in a held-out take
+    rng = np.random.default_rng(0)
+    train = rng.standard_normal((300, 4)) * [1.0, 1.0, 1.0, 1e-5]
+    held_out = rng.standard_normal((100, 4)) * [1.0, 1.0, 1.0, 1e-3]
+    unfloored = StandardScaler(scale_floor=0.0).fit(train).transform(held_out)
+    floored = StandardScaler().fit(train).transform(held_out)
+    assert np.abs(unfloored[:, 3]).max() > 100
+    assert np.abs(floored[:, 3]).max() < 1
