@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import sklearn
 from numpy.testing import assert_array_equal
+from sklearn.model_selection import cross_val_score
 
 from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM
 from sklearn_crbm.datasets import (
@@ -101,12 +102,31 @@ def test_fit_without_routing_says_how_to_turn_it_on(walks):
 def test_fitting_a_loaders_data_without_its_sequence_ids_warns(walks):
     pipe = make_motion_pipeline(walks.skeleton, ConditionalRBM(4, n_iter=1))
     for fit in (ConditionalRBM(4, n_iter=1).fit, pipe.fit):
-        with pytest.warns(UserWarning, match="holds 3 sequences"):
+        with pytest.warns(UserWarning, match="holds frames of 3 sequences"):
             fit(walks.data)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         ConditionalRBM(4, n_iter=1).fit(walks.data, sequence_ids=walks.sequence_ids)
         ConditionalRBM(4, n_iter=1).fit(walks.data[walks.sequence_ids == 0])
+
+
+def test_a_fold_of_a_loaders_data_without_sequence_ids_warns(walks):
+    # cross_val_score's folds are copies of the loader's rows
+    with sklearn.config_context(enable_metadata_routing=False):
+        with pytest.warns(UserWarning, match="holds frames of 2 sequences"):
+            cross_val_score(ConditionalRBM(4, n_iter=1), walks.data, cv=3)
+
+
+def test_a_split_that_cuts_a_sequence_warns(walks):
+    model = ConditionalRBM(4, n_iter=1)
+    fold = np.r_[0:30, 40:60]  # the second file of three cut in the middle
+    with pytest.warns(UserWarning, match=r"only part of 1 \(ids \[1\]\).*GroupKFold"):
+        model.fit(walks.data[fold], sequence_ids=walks.sequence_ids[fold])
+    whole = np.r_[0:20, 40:60]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model.fit(walks.data[whole], sequence_ids=walks.sequence_ids[whole])
+        model.fit(walks.data[:10])  # part of one take, deliberately
 
 
 # -- float32 in, float32 out ---------------------------------------------------

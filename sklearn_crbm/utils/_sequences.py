@@ -35,50 +35,123 @@ __all__ = [
 CHUNK_FRAMES = 4096
 
 
-# Arrays whose sequences a loader knows: id(array) -> (weak reference,
-# number of sequences); see remember_sequences.
+# Arrays whose sequences a loader knows: id(array) -> _LoadedSequences; see
+# remember_sequences.
 _KNOWN_SEQUENCES = {}
+# Rows of X looked up in a loader's array before X counts as made of them.
+_PROBE_ROWS = 16
+
+
+class _LoadedSequences:
+    """What a loader said of its array: a weak reference and the sequence ids."""
+
+    def __init__(self, X, sequence_ids):
+        key = id(X)
+        forget = lambda _, key=key: _KNOWN_SEQUENCES.pop(key, None)  # noqa: E731
+        self.reference = weakref.ref(X, forget)
+        self.sequence_ids = np.asarray(sequence_ids)
+        self._row_index = None
+
+    def row_index(self, data):
+        """Each row's bytes -> its position, built on the first look-up."""
+        if self._row_index is None:
+            self._row_index = {row.tobytes(): i for i, row in enumerate(data)}
+        return self._row_index
 
 
 def remember_sequences(X, sequence_ids):
     """Note that the array ``X`` (a loader's result) holds the sequences of
-    ``sequence_ids``, so that a ``fit`` given ``X`` without them can warn."""
-    key = id(X)
-    forget = lambda _, key=key: _KNOWN_SEQUENCES.pop(key, None)  # noqa: E731
-    n_sequences = len(np.unique(sequence_ids))
-    _KNOWN_SEQUENCES[key] = (weakref.ref(X, forget), n_sequences)
+    ``sequence_ids``, so that a ``fit`` given ``X`` or rows of it without
+    them, or a split that cuts them, can warn."""
+    _KNOWN_SEQUENCES[id(X)] = _LoadedSequences(X, sequence_ids)
 
 
-def _known_sequence_count(X):
-    """The number of sequences a loader said ``X`` (or the array it views) holds."""
+def _viewed_loader_ids(X):
+    """The loader's sequence ids of ``X``, a loader's array or a view of it."""
     while isinstance(X, np.ndarray):
-        reference, n_sequences = _KNOWN_SEQUENCES.get(id(X), (None, None))
-        if reference is not None and reference() is X:
-            return n_sequences
+        entry = _KNOWN_SEQUENCES.get(id(X))
+        if entry is not None and entry.reference() is X:
+            return entry.sequence_ids
         if X.base is None or len(X.base) != len(X):
             return None
         X = X.base
     return None
 
 
+def _copied_loader_ids(X):
+    """The loader's sequence id of every row of ``X``, where each row of ``X``
+    is a row of a loader's array (a cross-validation fold, a selection)."""
+    for entry in list(_KNOWN_SEQUENCES.values()):
+        data = entry.reference()
+        if data is None or data.shape[1:] != X.shape[1:] or data.dtype != X.dtype:
+            continue
+        index = entry.row_index(data)
+        probe = np.unique(np.linspace(0, len(X) - 1, _PROBE_ROWS).astype(np.intp))
+        if any(X[i].tobytes() not in index for i in probe):
+            continue
+        rows = [index.get(row.tobytes()) for row in X]
+        if None not in rows:
+            return entry.sequence_ids[rows], entry.sequence_ids
+    return None
+
+
+def _loader_sequences(X):
+    """``(ids of X's rows, ids of the loader's whole array)``, or None when
+    ``X`` is not made of a loader's rows."""
+    if not isinstance(X, np.ndarray) or X.ndim != 2 or len(X) == 0:
+        return None
+    ids = _viewed_loader_ids(X)
+    if ids is not None:
+        return ids, ids
+    return _copied_loader_ids(X)
+
+
+def _cut_sequences(row_ids, all_ids):
+    """The sequences of which ``row_ids`` holds some frames but not all."""
+    present, counts = np.unique(row_ids, return_counts=True)
+    ids, totals = np.unique(all_ids, return_counts=True)
+    whole = dict(zip(ids.tolist(), totals.tolist(), strict=True))
+    return [
+        s
+        for s, n in zip(present.tolist(), counts.tolist(), strict=True)
+        if n < whole[s]
+    ]
+
+
 def warn_if_sequences_unmarked(X, sequence_ids, method, stacklevel=3):
-    """Warn when ``X`` is a loader's array of several sequences and
-    ``sequence_ids`` is None: every frame would count as one sequence."""
-    if sequence_ids is not None:
+    """Warn when ``X`` holds frames of several of a loader's sequences and
+    ``sequence_ids`` is None (every frame would count as one sequence), or
+    when a split cut one or two of them in the middle (as ``KFold`` does)."""
+    found = _loader_sequences(X)
+    if found is None:
         return
-    n_sequences = _known_sequence_count(X)
-    if n_sequences is None or n_sequences < 2:
-        return
-    warnings.warn(
-        f"{method} got no sequence_ids, but X is the data of a loader's result "
-        f"that holds {n_sequences} sequences (files): they are treated as one "
-        "sequence, and the jumps between them as motion. Pass sequence_ids="
-        "data.sequence_ids (through a Pipeline, after sklearn.set_config("
-        "enable_metadata_routing=True)); to cross-validate, split whole "
-        "sequences: cv=GroupKFold() with groups=data.sequence_ids.",
-        UserWarning,
-        stacklevel=stacklevel,
+    row_ids, all_ids = found
+    n_sequences = len(np.unique(row_ids))
+    cut = _cut_sequences(row_ids, all_ids)
+    split_advice = (
+        "to cross-validate, split whole sequences: cv=GroupKFold() with "
+        "groups=data.sequence_ids."
     )
+    if sequence_ids is None and n_sequences >= 2:
+        warnings.warn(
+            f"{method} got no sequence_ids, but X holds frames of {n_sequences} "
+            "sequences (files) of a loader's result: they are treated as one "
+            "sequence, and the jumps between them as motion. Pass sequence_ids="
+            "data.sequence_ids (through a Pipeline, after sklearn.set_config("
+            "enable_metadata_routing=True)); " + split_advice,
+            UserWarning,
+            stacklevel=stacklevel,
+        )
+    elif n_sequences >= 2 and 1 <= len(cut) <= 2:
+        warnings.warn(
+            f"{method}: X holds whole sequences of a loader's result and only "
+            f"part of {len(cut)} (ids {cut}), as when a split such as KFold cuts "
+            "sequences in the middle: the frames of a cut sequence are scored "
+            "or trained without the frames before them. If that is not meant, "
+            + split_advice,
+            UserWarning,
+            stacklevel=stacklevel,
+        )
 
 
 @dataclass(frozen=True)
