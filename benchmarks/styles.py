@@ -81,6 +81,7 @@ from abc import ABC, abstractmethod  # noqa: E402
 from functools import partial  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+import joblib  # noqa: E402
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
 from _common import (  # noqa: E402
@@ -546,6 +547,7 @@ def transitions(candidate, split, args, rng):
         cells[f"{first}->{second}"] = dict(
             new_style=float(verdict.correct[judged].mean()),
             alive=float(verdict.alive[judged].mean()),
+            new_alive=float(verdict.accepted[judged].mean()),
             blown_up=int(blown.sum()),
         )
     return cells
@@ -650,7 +652,55 @@ def speed(candidate, split, n_frames_trained, n_iter, fit_seconds, rng):
     )
     if isinstance(candidate, StyleModel):
         out.update(epoch_against_products(candidate, split))
+        out.update(generation_against_products(candidate, split, rng))
     return out
+
+
+def _recorded_products(run):
+    """The operand shapes and dtypes of every ``numpy.matmul`` that ``run()`` calls."""
+    shapes, matmul = [], np.matmul
+
+    def recording(a, b, *rest, **kwargs):
+        shapes.append((a.shape, b.shape, np.result_type(a, b)))
+        return matmul(a, b, *rest, **kwargs)
+
+    np.matmul = recording
+    try:
+        run()
+    finally:
+        np.matmul = matmul
+    return shapes
+
+
+def _products_alone(shapes):
+    """A function running products of ``shapes`` (random operands) alone."""
+    rng = np.random.default_rng(0)
+    operands = [
+        (rng.random(a).astype(dtype), rng.random(b).astype(dtype))
+        for a, b, dtype in shapes
+    ]
+
+    def products():
+        for a, b in operands:
+            np.matmul(a, b)
+
+    return products
+
+
+def generation_against_products(candidate, split, rng, n_sequences=100, n_frames=30):
+    """Frames per second of ``n_sequences`` generated together against the
+    bound set by the generation's matrix products alone (the issue's batch
+    criterion: at least 0.6 of it)."""
+    weights = label_weights(split.styles, n_frames, NORMAL)
+    history = split.seed_windows(NORMAL, candidate.history_length(), n_sequences, rng)
+    run = partial(candidate.generate, weights, history, _draw_seed(rng))
+    shapes = _recorded_products(run)
+    generation, alone = seconds(run), seconds(_products_alone(shapes))
+    return dict(
+        generation_seconds=generation,
+        generation_products_seconds=alone,
+        generation_of_products_bound=alone / generation,
+    )
 
 
 def epoch_against_products(candidate, split, repeats=3):
@@ -669,27 +719,8 @@ def epoch_against_products(candidate, split, repeats=3):
         model = candidate.estimator(**params)
         model.partial_fit(Z, styles, sequence_ids=ids)
 
-    shapes, matmul = [], np.matmul
-
-    def recording(a, b, *rest, **kwargs):
-        shapes.append((a.shape, b.shape))
-        return matmul(a, b, *rest, **kwargs)
-
-    np.matmul = recording
-    try:
-        one_epoch()
-    finally:
-        np.matmul = matmul
-    rng = np.random.default_rng(0)
-    operands = [
-        (rng.random(a, dtype=np.float32), rng.random(b, dtype=np.float32))
-        for a, b in shapes
-    ]
-
-    def products():
-        for a, b in operands:
-            matmul(a, b)
-
+    shapes = _recorded_products(one_epoch)
+    products = _products_alone(shapes)
     epoch, alone = seconds(one_epoch, repeats), seconds(products, repeats)
     return dict(
         epoch_seconds=epoch,
@@ -827,6 +858,10 @@ def run_candidate(name, walks, split, args, seed):
     fit = partial(candidate.fit, Z, styles, ids, seed=seed, n_iter=args.n_iter)
     fit_seconds = seconds(fit)
     print(f"  {name}, seed {seed}: trained in {fit_seconds:.0f} s", flush=True)
+    if args.models:  # to look at what it generates (plot_motion_strip)
+        folder = Path(args.models)
+        folder.mkdir(parents=True, exist_ok=True)
+        joblib.dump(candidate, folder / f"{name}_seed{seed}.joblib")
     n_iter = candidate.n_epochs()
     measures = {  # in this order: they draw from one random stream
         "style": lambda: style_kept(candidate, split, args, rng),
@@ -875,6 +910,7 @@ def main(argv=None):
     p.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
     p.add_argument("--n-frames", type=int, default=1000)
     p.add_argument("--n-sequences", type=int, default=6)
+    p.add_argument("--models", help="folder to save every fitted candidate in")
     p.set_defaults(output=str(RESULTS / "styles.json"))
     args = p.parse_args(argv)
 
