@@ -1,4 +1,4 @@
-"""Many styles from one model: the factored CRBM and its alternatives (issue 29).
+"""Many styles from one model: the factored CRBM and its alternatives (issues 29, 35).
 
 Data: the Bandai Namco walks in seven styles (``load_bandai_walks``: takes
 001-006 of active, elderly, exhausted, feminine, masculine, normal and
@@ -37,7 +37,7 @@ Measurements (the issue's "Done when"), each of ``--parts``:
   (within 10% of their difference).
 - ``transitions``: the 42 ordered pairs, seeded with frames of the first
   style, switched to the second at half the sequence: windows from 60
-  frames after the switch judged as the new style, and alive.
+  frames after the switch judged as the new style, alive, and both.
 - ``likelihood``: held-out log-likelihood per frame of the takes 006 with
   their labels (frames from the 13th of each take, so that every order up
   to 12 has a full history), with the standard error of the annealed
@@ -57,14 +57,22 @@ Measurements (the issue's "Done when"), each of ``--parts``:
 - ``speed``: training seconds per epoch (``separate``: its seven models
   together); generation frames per second for one sequence and per sequence
   of 100 generated together (the default Gibbs steps); for the labelled
-  models, one epoch against its matrix products alone.
+  models, one epoch against its matrix products alone, and the time of the
+  matrix products alone of 100 sequences generated together as a fraction
+  of the generation's (the batch criterion: at least 0.6).
 
 Run from the repository root, e.g.::
 
     python benchmarks/styles.py --seeds 0 --n-iter 50
     python benchmarks/styles.py --parts style likelihood --candidates separate
+    python benchmarks/styles.py --tabulate seed0.json seed1.json
 
-Prints one table and writes JSON to ``benchmarks/results/styles.json``.
+Prints one table of the issue's measures over the seeds (shares kept and
+alive, transitions and fill-in as means with a 95% bootstrap interval over
+the seeds) and the share kept and alive per style, and writes JSON to
+``benchmarks/results/styles.json``; ``--tabulate`` prints the tables of
+earlier runs' JSON files (seeds run in separate processes) merged;
+``--models`` saves the fitted candidates, to look at what they generate.
 """
 
 import os
@@ -81,6 +89,7 @@ from abc import ABC, abstractmethod  # noqa: E402
 from functools import partial  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+import joblib  # noqa: E402
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
 from _common import (  # noqa: E402
@@ -546,6 +555,7 @@ def transitions(candidate, split, args, rng):
         cells[f"{first}->{second}"] = dict(
             new_style=float(verdict.correct[judged].mean()),
             alive=float(verdict.alive[judged].mean()),
+            new_alive=float(verdict.accepted[judged].mean()),
             blown_up=int(blown.sum()),
         )
     return cells
@@ -650,7 +660,55 @@ def speed(candidate, split, n_frames_trained, n_iter, fit_seconds, rng):
     )
     if isinstance(candidate, StyleModel):
         out.update(epoch_against_products(candidate, split))
+        out.update(generation_against_products(candidate, split, rng))
     return out
+
+
+def _recorded_products(run):
+    """The operand shapes and dtypes of every ``numpy.matmul`` that ``run()`` calls."""
+    shapes, matmul = [], np.matmul
+
+    def recording(a, b, *rest, **kwargs):
+        shapes.append((a.shape, b.shape, np.result_type(a, b)))
+        return matmul(a, b, *rest, **kwargs)
+
+    np.matmul = recording
+    try:
+        run()
+    finally:
+        np.matmul = matmul
+    return shapes
+
+
+def _products_alone(shapes):
+    """A function running products of ``shapes`` (random operands) alone."""
+    rng = np.random.default_rng(0)
+    operands = [
+        (rng.random(a).astype(dtype), rng.random(b).astype(dtype))
+        for a, b, dtype in shapes
+    ]
+
+    def products():
+        for a, b in operands:
+            np.matmul(a, b)
+
+    return products
+
+
+def generation_against_products(candidate, split, rng, n_sequences=100, n_frames=30):
+    """Frames per second of ``n_sequences`` generated together against the
+    bound set by the generation's matrix products alone (the issue's batch
+    criterion: at least 0.6 of it)."""
+    weights = label_weights(split.styles, n_frames, NORMAL)
+    history = split.seed_windows(NORMAL, candidate.history_length(), n_sequences, rng)
+    run = partial(candidate.generate, weights, history, _draw_seed(rng))
+    shapes = _recorded_products(run)
+    generation, alone = seconds(run), seconds(_products_alone(shapes))
+    return dict(
+        generation_seconds=generation,
+        generation_products_seconds=alone,
+        generation_of_products_bound=alone / generation,
+    )
 
 
 def epoch_against_products(candidate, split, repeats=3):
@@ -669,27 +727,8 @@ def epoch_against_products(candidate, split, repeats=3):
         model = candidate.estimator(**params)
         model.partial_fit(Z, styles, sequence_ids=ids)
 
-    shapes, matmul = [], np.matmul
-
-    def recording(a, b, *rest, **kwargs):
-        shapes.append((a.shape, b.shape))
-        return matmul(a, b, *rest, **kwargs)
-
-    np.matmul = recording
-    try:
-        one_epoch()
-    finally:
-        np.matmul = matmul
-    rng = np.random.default_rng(0)
-    operands = [
-        (rng.random(a, dtype=np.float32), rng.random(b, dtype=np.float32))
-        for a, b in shapes
-    ]
-
-    def products():
-        for a, b in operands:
-            matmul(a, b)
-
+    shapes = _recorded_products(one_epoch)
+    products = _products_alone(shapes)
     epoch, alone = seconds(one_epoch, repeats), seconds(products, repeats)
     return dict(
         epoch_seconds=epoch,
@@ -700,123 +739,196 @@ def epoch_against_products(candidate, split, repeats=3):
 
 
 # ----------------------------------------------------------------- report
-def _percent(values):
-    return f"{100 * np.mean(values):.0f}%"
-
-
-def _ratio_range(values):
-    values = np.asarray(values, dtype=float)
-    if np.all(np.isnan(values)):
-        return "nan"
-    return f"{np.nanmin(values):.2f}-{np.nanmax(values):.2f}"
-
-
-def _mean(cells, key):
-    return np.mean([cell[key] for cell in cells])
-
-
-def _kept(cells):
-    kept, alive = (_percent([c[k] for c in cells]) for k in ("kept", "kept_alive"))
-    return f"{kept} ({alive})"
-
-
-def _pace(cells):
-    passed = sum(c["pace_ok"] for c in cells)
-    total = sum(len(c["amplitude_ratio"]) for c in cells)
-    amplitude = _ratio_range([r for c in cells for r in c["amplitude_ratio"]])
-    frequency = _ratio_range([r for c in cells for r in c["frequency_ratio"]])
-    return f"{passed}/{total}; amp {amplitude}, freq {frequency}"
-
-
-def _blends(cells):
-    between = sum(c["speed_between"] and c["frequency_between"] for c in cells)
-    return f"{_percent([c['one_of_two'] for c in cells])}; {between}/{len(cells)}"
-
-
-def _transitions(cells):
-    new, alive = (_percent([c[k] for c in cells]) for k in ("new_style", "alive"))
-    return f"{new} ({alive})"
-
-
-def _likelihood(cells):
-    keys = ("mean", "standard_error", "reverse_gap")
-    mean, error, gap = (_mean(cells, k) for k in keys)
-    return f"{mean:.2f} (SE {error:.1e}, gap {gap:.1e})"
-
-
-def _recognition(cells):
-    correct = [c["correct"] for c in cells]
-    return f"{min(correct)}-{max(correct)}/{cells[0]['of']}"
-
-
-def _one_take(cells):
-    mean = np.mean([c["log_likelihood"]["mean"] for c in cells])
-    return f"{_kept(cells)}; LL {mean:.2f}"
-
-
-def _speed(cells):
-    epoch, one = _mean(cells, "seconds_per_epoch"), _mean(cells, "generation_fps_one")
-    many = _mean(cells, "generation_fps_per_sequence_of_100")
-    text = f"{epoch:.3f} s/epoch; {one:.0f}, {many:.0f}/seq fps"
-    if "epoch_over_products" in cells[0]:
-        text += f"; epoch/products {_mean(cells, 'epoch_over_products'):.2f}"
-    return text
-
-
-# (column, part of the results, formatter of its cells over the seeds).  A
-# part's result per seed is one cell (ONE_CELL_PARTS) or a dict of cells:
-# per style (style, one-take), per pair (blends, transitions), per case
-# (fill-in log ratios).
+# The issue's "Done when" in one table: one row per candidate (and seeding),
+# each column a measure over the training seeds.  A part's result per seed
+# is one cell (ONE_CELL_PARTS) or a dict of cells: per style (style,
+# one-take), per pair (blends, transitions), per case (fill-in log ratios).
 ONE_CELL_PARTS = ("likelihood", "recognition", "speed")
-COLUMNS = [
-    ("kept (alive)", "style", _kept),
-    ("last 100 frames in pace", "style", _pace),
-    ("blown up", "style", lambda cells: str(sum(c["blown_up"] for c in cells))),
-    ("blends: 1 of 2; between", "blends", _blends),
-    ("transitions: new (alive)", "transitions", _transitions),
-    ("held-out LL/frame", "likelihood", _likelihood),
-    ("recognised", "recognition", _recognition),
-    ("one take: kept (alive); LL", "one-take", _one_take),
-    ("speed: training; generation", "speed", _speed),
-]
-FILLIN_COLUMN = "fill-in log ratio [95%]"
 
 
-def _cells(per_seed, part, seeding):
-    """Every cell of ``part`` over the seeds (of one seeding for "style")."""
-    cells = []
+def _per_seed(per_seed, part, seeding=None):
+    """``part``'s cells of every seed that has it: a list (one per seed) of lists."""
+    rows = []
     for result in per_seed.values():
         found = result.get(part)
         if part == "style" and found is not None:
             found = found.get(seeding)
         if found is None:
             continue
-        cells += [found] if part in ONE_CELL_PARTS else list(found.values())
-    return cells
+        rows.append([found] if part in ONE_CELL_PARTS else list(found.values()))
+    return rows
 
 
-def table(results, rng):
-    """One row per candidate (and seeding), its measurements over the seeds."""
+def _interval(rows, key, rng, percent=True):
+    """Mean of ``key`` of the cells (None: the cells) over the seeds, with its
+    95% bootstrap interval."""
+    values = [[cell if key is None else cell[key] for cell in row] for row in rows]
+    mean, low, high = bootstrap_mean(values, seed=rng)
+    if percent:
+        return f"{100 * mean:.0f}% [{100 * low:.0f}, {100 * high:.0f}]"
+    return f"{mean:+.3f} [{low:+.3f}, {high:+.3f}]"
+
+
+def _fillin(rows, rng):
+    """Mean log ratio over styles, parts and seeds, its interval over the
+    seed-cells (each a row of the bootstrap: one seed gives an interval too)."""
+    return _interval([[ratio] for row in rows for ratio in row], None, rng, False)
+
+
+def _lowest_style(per_seed, seeding):
+    """The style whose mean share kept and alive over the seeds is lowest."""
+    means = {}
+    for result in per_seed.values():
+        for style, cell in (result.get("style") or {}).get(seeding, {}).items():
+            means.setdefault(style, []).append(cell["kept_alive"])
+    style = min(means, key=lambda s: np.mean(means[s]))
+    return f"{style} {100 * np.mean(means[style]):.0f}%"
+
+
+def _pace(rows):
+    cells = [cell for row in rows for cell in row]
+    passed = sum(c["pace_ok"] for c in cells)
+    total = sum(len(c["amplitude_ratio"]) for c in cells)
+    return f"{passed}/{total}"
+
+
+def _blown_up_total(rows):
+    return str(sum(cell["blown_up"] for row in rows for cell in row))
+
+
+def _blends(rows):
+    """Pairs (mean over seeds) with the speed between the two styles', pairs
+    with at least 80% of windows judged one of the two (and the mean share),
+    pairs with the step frequency between."""
+    n = len(rows[0])
+
+    def pairs(passes):
+        return f"{np.mean([sum(passes(c) for c in row) for row in rows]):.1f}/{n}"
+
+    one_of_two = np.mean([c["one_of_two"] for row in rows for c in row])
+    return (
+        f"{pairs(lambda c: c['speed_between'])}; "
+        f"{pairs(lambda c: c['one_of_two'] >= 0.8)} ({100 * one_of_two:.0f}%); "
+        f"freq {pairs(lambda c: c['frequency_between'])}"
+    )
+
+
+def _likelihood(rows):
+    means = [row[0]["mean"] for row in rows]
+    error = max(row[0]["standard_error"] for row in rows)
+    gap = max(row[0]["reverse_gap"] for row in rows)
+    span = f" ({min(means):.2f} to {max(means):.2f})" if len(means) > 1 else ""
+    return f"{np.mean(means):.2f}{span}; SE {error:.1e}, gap {gap:.2f}"
+
+
+def _recognition(rows):
+    correct = [row[0]["correct"] for row in rows]
+    return f"{min(correct)}-{max(correct)}/{rows[0][0]['of']}"
+
+
+def _batch(rows):
+    cells = [row[0] for row in rows if "generation_of_products_bound" in row[0]]
+    if not cells:
+        return "-"
+    return f"{np.mean([c['generation_of_products_bound'] for c in cells]):.2f}"
+
+
+def _one_take(rows):
+    cells = [cell for row in rows for cell in row]
+    alive = np.mean([c["kept_alive"] for c in cells])
+    mean = np.mean([c["log_likelihood"]["mean"] for c in cells])
+    return f"{100 * alive:.0f}%; LL {mean:.2f}"
+
+
+def _epoch(rows):
+    return f"{np.mean([row[0]['seconds_per_epoch'] for row in rows]):.2f}"
+
+
+# (column, part, formatter of the per-seed rows of cells; ``rng`` for the
+# bootstrap), for the table's columns in the order of the issue.
+COLUMNS = [
+    ("kept & alive [95%]", "style", lambda r, g: _interval(r, "kept_alive", g)),
+    (
+        "kept",
+        "style",
+        lambda r, g: f"{100 * np.mean([c['kept'] for x in r for c in x]):.0f}%",
+    ),
+    ("in pace", "style", lambda r, g: _pace(r)),
+    ("blown up", "style", lambda r, g: _blown_up_total(r)),
+    (
+        "transitions: new & alive [95%]",
+        "transitions",
+        lambda r, g: _interval(r, "new_alive", g),
+    ),
+    (
+        "blends: speed between; 1 of 2 >= 80% (mean); freq",
+        "blends",
+        lambda r, g: _blends(r),
+    ),
+    ("held-out LL/frame", "likelihood", lambda r, g: _likelihood(r)),
+    ("one take: kept & alive; LL", "one-take", lambda r, g: _one_take(r)),
+    ("recognised", "recognition", lambda r, g: _recognition(r)),
+    ("fill-in log ratio [95%]", "fillin", lambda r, g: _fillin(r, g)),
+    ("100 together / products", "speed", lambda r, g: _batch(r)),
+    ("s/epoch", "speed", lambda r, g: _epoch(r)),
+]
+
+
+def _seedings(per_seed):
+    first = next(iter(per_seed.values()))
+    return list(first.get("style") or {None: None})
+
+
+def table(results, seed=0):
+    """One row per candidate (and seeding): the issue's measures over the seeds
+    (``seed``: of the bootstrap)."""
     rows = []
     for name, per_seed in results.items():
-        first = next(iter(per_seed.values()))
-        for k, seeding in enumerate(first.get("style") or {"": None}):
+        for k, seeding in enumerate(_seedings(per_seed)):
             row = {
                 "candidate": f"{name} ({seeding})" if seeding else name,
-                "params": str(first["n_parameters"]),
+                "seeds": ",".join(str(seed) for seed in per_seed),
+                "params": str(next(iter(per_seed.values()))["n_parameters"]),
             }
+            if k == 0 and seeding is not None:
+                row["lowest style"] = _lowest_style(per_seed, seeding)
             for column, part, formatter in COLUMNS:
-                cells = _cells(per_seed, part, seeding)
+                cells = _per_seed(per_seed, part, seeding)
                 shown = cells and (part == "style" or k == 0)
-                row[column] = formatter(cells) if shown else "-"
-            ratios = _cells(per_seed, "fillin", seeding)
-            row[FILLIN_COLUMN] = "-"
-            if ratios and k == 0:
-                mean, low, high = bootstrap_mean(ratios, seed=rng)
-                row[FILLIN_COLUMN] = f"{mean:+.3f} [{low:+.3f}, {high:+.3f}]"
+                # each column its own stream: its interval does not depend
+                # on the columns before it
+                fresh = np.random.default_rng(seed)
+                row[column] = formatter(cells, fresh) if shown else "-"
             rows.append(row)
-    headers = ["candidate", "params", *(c for c, _, _ in COLUMNS), FILLIN_COLUMN]
-    print_table(rows, [(header, header, "s") for header in headers])
+    headers = ["candidate", "seeds", "params", "lowest style"]
+    headers += [column for column, _, _ in COLUMNS]
+    print_table(
+        [{h: row.get(h, "-") for h in headers} for row in rows],
+        [(h, h, "s") for h in headers],
+    )
+    per_style_table(results)
+
+
+def per_style_table(results):
+    """Windows kept and alive per style, mean over the seeds."""
+    rows = []
+    for name, per_seed in results.items():
+        for seeding in _seedings(per_seed):
+            if seeding is None:
+                continue
+            means = {}
+            for result in per_seed.values():
+                for style, cell in result["style"][seeding].items():
+                    means.setdefault(style, []).append(cell["kept_alive"])
+            row = {"candidate": f"{name} ({seeding})"}
+            row.update({s: f"{100 * np.mean(v):.0f}%" for s, v in means.items()})
+            rows.append(row)
+    if rows:
+        styles = [key for key in rows[0] if key != "candidate"]
+        print()
+        print_table(
+            rows, [("candidate", "candidate", "s")] + [(s, s, "s") for s in styles]
+        )
 
 
 # ------------------------------------------------------------------- main
@@ -824,9 +936,18 @@ def run_candidate(name, walks, split, args, seed):
     Z, styles, ids = split.frames(split.train)
     rng = np.random.default_rng(seed)
     candidate = CANDIDATES[name]()
-    fit = partial(candidate.fit, Z, styles, ids, seed=seed, n_iter=args.n_iter)
-    fit_seconds = seconds(fit)
-    print(f"  {name}, seed {seed}: trained in {fit_seconds:.0f} s", flush=True)
+    saved = Path(args.models or "") / f"{name}_seed{seed}.joblib"
+    if args.models and saved.exists():  # fitted by an earlier run
+        vars(candidate).update(joblib.load(saved))
+        fit_seconds = float("nan")
+        print(f"  {name}, seed {seed}: loaded {saved}", flush=True)
+    else:
+        fit = partial(candidate.fit, Z, styles, ids, seed=seed, n_iter=args.n_iter)
+        fit_seconds = seconds(fit)
+        print(f"  {name}, seed {seed}: trained in {fit_seconds:.0f} s", flush=True)
+        if args.models:  # to look at what it generates, or measure more parts
+            saved.parent.mkdir(parents=True, exist_ok=True)
+            joblib.dump(vars(candidate), saved)
     n_iter = candidate.n_epochs()
     measures = {  # in this order: they draw from one random stream
         "style": lambda: style_kept(candidate, split, args, rng),
@@ -866,6 +987,19 @@ def cached_cell(name, seed, args, walks, split):
     return result
 
 
+def tabulate(paths):
+    """Print the tables of the results in earlier runs' JSON files, merged
+    (seeds, and the parts of a seed)."""
+    results = {}
+    for path in paths:
+        for name, per_seed in json.loads(Path(path).read_text())["results"].items():
+            for seed, parts in per_seed.items():  # parts of one seed run apart merge
+                results.setdefault(name, {}).setdefault(seed, {}).update(parts)
+    print(f"\nBandai walks, 7 styles; from {', '.join(paths)}\n")
+    table(results)
+    return results
+
+
 def main(argv=None):
     p = parser(__doc__)
     p.add_argument("--n-iter", type=int, help="epochs (default: the package's)")
@@ -875,8 +1009,19 @@ def main(argv=None):
     p.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
     p.add_argument("--n-frames", type=int, default=1000)
     p.add_argument("--n-sequences", type=int, default=6)
+    p.add_argument(
+        "--models", help="folder to save fitted candidates in (and reuse them from)"
+    )
+    p.add_argument(
+        "--tabulate",
+        nargs="+",
+        metavar="JSON",
+        help="print the tables of earlier runs' JSON (merged) instead of running",
+    )
     p.set_defaults(output=str(RESULTS / "styles.json"))
     args = p.parse_args(argv)
+    if args.tabulate:
+        return tabulate(args.tabulate)
 
     sklearn.set_config(enable_metadata_routing=True)
     walks = load_bandai_walks(args.data_home)
@@ -891,7 +1036,7 @@ def main(argv=None):
         f"{args.n_sequences} x {args.n_frames} frames per style; seeds {args.seeds}, "
         f"n_iter {args.n_iter or 'default'}\n"
     )
-    table(results, np.random.default_rng(0))
+    table(results)
     output = Path(args.output)
     output.parent.mkdir(parents=True, exist_ok=True)
     output.write_text(json.dumps({"args": vars(args), "results": results}, indent=1))

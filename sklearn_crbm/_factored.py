@@ -44,17 +44,22 @@ class FactoredCRBM(BaseStyleModel):
         One style-feature-to-factor matrix for the three kinds of factor
         (the released code's default); False learns one per kind.
     learning_rate : float, default=1e-2
-        Step size of the undirected weights and the biases; the directed
-        weights (past to visible, past to hidden), the style-feature-to-factor
-        weights and the label-to-feature weights ``R`` take a tenth of it.
+        Step size of every weight and bias but the autoregressive factors
+        (past to visible) and the label-to-feature weights ``R``, which take
+        a tenth of it (as the released code).
     momentum : float, default=0.9
         Momentum used after the first ``momentum_delay`` epochs.
     momentum_delay : int, default=5
         Number of epochs trained without momentum.
-    momentum_ramp : int, default=5
+    momentum_ramp : int, default=0
         Number of epochs after ``momentum_delay`` over which the momentum
-        rises linearly to ``momentum`` (0: at once, as the released code);
-        the three-way weights can diverge when it starts at once.
+        rises linearly to ``momentum`` (0: at once, as the released code).
+    max_step : float or None, default=0.25
+        Largest norm of one minibatch's step of each weight matrix, as a
+        fraction of the matrix's norm before the step (the velocity is
+        scaled down to it); None: unbounded, as the released code.  It
+        keeps the three-way weights from running away when momentum
+        starts.
     weight_decay : float, default=2e-4
         L2 penalty on every weight (not on biases).
     cd_steps : int, default=10
@@ -178,6 +183,7 @@ class FactoredCRBM(BaseStyleModel):
         "n_style_features": [Interval(Integral, 1, None, closed="left")],
         "shared_style_weights": ["boolean"],
         "momentum_ramp": [Interval(Integral, 0, None, closed="left")],
+        "max_step": [Interval(Real, 0, None, closed="neither"), None],
         "n_gibbs": [Interval(Integral, 0, None, closed="left")],
         "learning_rate": [Interval(Real, 0, None, closed="neither")],
     }
@@ -211,7 +217,8 @@ class FactoredCRBM(BaseStyleModel):
         learning_rate=1e-2,
         momentum=0.9,
         momentum_delay=5,
-        momentum_ramp=5,
+        momentum_ramp=0,
+        max_step=0.25,
         weight_decay=2e-4,
         cd_steps=10,
         batch_size=100,
@@ -241,6 +248,7 @@ class FactoredCRBM(BaseStyleModel):
         self.momentum = momentum
         self.momentum_delay = momentum_delay
         self.momentum_ramp = momentum_ramp
+        self.max_step = max_step
         self.weight_decay = weight_decay
         self.cd_steps = cd_steps
         self.batch_size = batch_size

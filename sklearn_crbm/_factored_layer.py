@@ -31,26 +31,21 @@ from .utils._random import sample_bernoulli
 __all__ = ["FactoredFrames", "FactoredLayer"]
 
 # Relative learning rates (of the estimator's ``learning_rate``) of the
-# groups that do not take the full rate: every directed group (past to
-# visible and past to hidden), the style features' weights to the factors
-# and the label features.  The released code takes the past-to-hidden and
-# style-to-factor weights at the full rate; on the Bandai walks that
-# diverges, within tens of epochs, for some training seeds.
+# groups that do not take the full rate, as in the released code: the
+# autoregressive factors (past to visible) and the label features ``R``.
 RATES = {
     "past_visible_factors": 0.1,
     "visible_from_factors": 0.1,
-    "past_hidden_factors": 0.1,
-    "hidden_from_factors": 0.1,
     "label_features": 0.1,
-    "style_factors": 0.1,
-    "style_undirected": 0.1,
-    "style_hidden": 0.1,
-    "style_visible": 0.1,
 }
 
 
 def _weights(shape):
     return lambda layer, rng: small_normal(rng, shape(layer), layer.dtype)
+
+
+def _biases(shape):
+    return lambda layer, rng: np.zeros(shape(layer), layer.dtype)
 
 
 def _group(name, shape, *, decayed=True, initial=None):
@@ -63,21 +58,9 @@ def _group(name, shape, *, decayed=True, initial=None):
     )
 
 
-# Where the hidden biases start: -1, mostly off, as the CRBM's.
-HIDDEN_BIAS_START = -1.0
-
-
-def _hidden_bias_start(layer, rng):
-    return small_normal(rng, (layer.n_components,), layer.dtype) + HIDDEN_BIAS_START
-
-
-# Standard deviation of the label features' start values.
-LABEL_FEATURE_SCALE = 1.0
-
-
-def _label_features_start(layer, rng):
-    shape = (layer.n_classes, layer.n_style_features)
-    return (LABEL_FEATURE_SCALE * rng.standard_normal(shape)).astype(layer.dtype)
+def _bias(name, shape):
+    """Biases start at zero, as in the released code, and are not decayed."""
+    return _group(name, shape, decayed=False, initial=_biases(shape))
 
 
 @functools.cache
@@ -97,11 +80,7 @@ def _groups(shared):
             "visible_from_factors",
             lambda p: (p.n_features, p.n_factors),
         ),
-        _group(
-            "label_features",
-            lambda p: (p.n_classes, p.n_style_features),
-            initial=_label_features_start,
-        ),
+        _group("label_features", lambda p: (p.n_classes, p.n_style_features)),
     ]
     style = (
         ["style_factors"]
@@ -115,13 +94,8 @@ def _groups(shared):
     for name in style:
         groups.append(_group(name, lambda p: (p.n_style_features, p.n_factors)))
     groups += [
-        _group(
-            "hidden_bias",
-            lambda p: (p.n_components,),
-            decayed=False,
-            initial=_hidden_bias_start,
-        ),
-        _group("visible_bias", lambda p: (p.n_features,), decayed=False),
+        _bias("hidden_bias", lambda p: (p.n_components,)),
+        _bias("visible_bias", lambda p: (p.n_features,)),
     ]
     return tuple(groups)
 

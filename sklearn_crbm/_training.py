@@ -53,6 +53,7 @@ class Schedule:
     history_noise: float
     history_noise_fraction: float
     momentum_ramp: int = 0
+    max_step: float | None = None
 
     @classmethod
     def of(cls, estimator):
@@ -140,9 +141,86 @@ class ProgressMonitor:
         )
 
 
+class StepBound:
+    """Each weight matrix's step per minibatch, at most ``max_step`` times its norm.
+
+    Wraps a :class:`~sklearn_crbm._parameters.MomentumUpdate`: after its
+    step, the velocity of every decayed group (every weight matrix; not the
+    biases) whose norm exceeds ``max_step`` times the matrix's norm before
+    the step is scaled down to it, and the step with it.  The velocity
+    carries the bound into the next steps.  Three-way weights feed back on
+    themselves (their statistics are products of the others): once a step
+    outgrows the weights, the next statistics grow with it and training
+    overflows within a few minibatches; bounded, the step grows the
+    weights by at most a fixed factor per minibatch and the chain catches up.
+    """
+
+    def __init__(self, update, max_step):
+        self.update = update
+        self.max_step = max_step
+        params = update.params
+        offsets = np.cumsum(
+            [0] + [math.prod(g.shape(params)) for g in self._sorted(params)]
+        )
+        self._parts = [
+            slice(int(start), int(stop))
+            for group, start, stop in zip(
+                self._sorted(params), offsets[:-1], offsets[1:], strict=True
+            )
+            if group.decayed
+        ]
+
+    @staticmethod
+    def _sorted(params):
+        return sorted(params.groups, key=lambda group: not group.decayed)
+
+    @property
+    def statistics(self):
+        return self.update.statistics
+
+    @property
+    def velocity(self):
+        return self.update.velocity
+
+    def _norms(self, flat):
+        ops = array_ops(flat)
+        return [ops.sqrt(ops.matmul(flat[part], flat[part])) for part in self._parts]
+
+    def apply(self, momentum, learning_rate, weight_decay):
+        """The momentum step, then each weight matrix's step bounded."""
+        parameters, velocity = self.update.params.flat, self.update.velocity.flat
+        ops = array_ops(parameters)
+        limits = self._norms(parameters)
+        self.update.apply(momentum, learning_rate, weight_decay)
+        for part, limit, norm in zip(
+            self._parts, limits, self._norms(velocity), strict=True
+        ):
+            if ops is np and not norm > self.max_step * limit:
+                continue  # the common case, without a pass over the matrix
+            scale = ops.minimum(self.max_step * limit / norm, 1.0)
+            step = velocity[part]
+            parameters[part] -= (1.0 - scale) * step
+            step *= scale
+
+
 def _rms(difference):
     ops = array_ops(difference)
     return float(ops.sqrt(ops.mean(difference * difference)))
+
+
+def _divergence_message(schedule, epoch):
+    """What a diverged training says: where, and what to change."""
+    bounded = (
+        ""
+        if schedule.max_step is None
+        else f" or max_step (now {schedule.max_step}), or raise momentum_ramp"
+    )
+    return (
+        f"Training diverged at epoch {epoch}: the weights became non-finite with "
+        f"learning_rate={schedule.learning_rate} and momentum={schedule.momentum}. "
+        f"Lower the learning rate{bounded}, and standardise the data, e.g. with "
+        "sklearn_crbm.preprocessing.StandardScaler."
+    )
 
 
 # Diverging weights overflow in the products before the epoch's check
@@ -202,6 +280,8 @@ def train_epochs(
     """
     params = layer.training_copy()
     update = MomentumUpdate(params, velocity)
+    if schedule.max_step is not None:
+        update = StepBound(update, schedule.max_step)
     # Minibatches gather rows: from a Fortran-ordered X (what many
     # transformers return) every row would be a strided read.
     ops = array_ops(X)
@@ -257,12 +337,7 @@ def train_epochs(
         squared_error = float(squared_error)  # one device sync per epoch
         reconstruction_error = squared_error / len(frames)
         if not params.is_finite() or not math.isfinite(squared_error):
-            raise TrainingDivergedError(
-                f"Training diverged at epoch {done + 1}: the weights became "
-                f"non-finite with learning_rate={schedule.learning_rate}. Lower the "
-                "learning rate (and momentum), and standardise the data, e.g. "
-                "with sklearn_crbm.preprocessing.StandardScaler."
-            )
+            raise TrainingDivergedError(_divergence_message(schedule, done + 1))
         if monitor is not None and monitor.is_due(done + 1):
             monitor.report(done + 1, params.fitted_copy(), reconstruction_error)
         if epoch >= n_epochs - n_averaged:

@@ -20,9 +20,9 @@ def styled_data(random_state=0, switching=True, n_sequences=8):
 
 def small_model(**params):
     defaults = dict(
-        n_components=8,
-        n_factors=6,
-        n_style_features=3,
+        n_components=16,  # fewer units stay at the start's saddle (gates near 0)
+        n_factors=12,
+        n_style_features=6,
         order=2,
         cd_steps=1,
         learning_rate=0.1,
@@ -54,17 +54,17 @@ def test_fit_learns_the_styles(fitted):
 
 def test_fitted_attributes_view_the_layer(fitted):
     layer = fitted._layer
-    assert fitted.visible_factors_.shape == (6, 6)
-    assert fitted.hidden_factors_.shape == (8, 6)
-    assert fitted.past_visible_factors_.shape == (12, 6)
-    assert fitted.label_features_.shape == (2, 3)
-    assert fitted.style_factors_.shape == (3, 6)
+    assert fitted.visible_factors_.shape == (6, 12)
+    assert fitted.hidden_factors_.shape == (16, 12)
+    assert fitted.past_visible_factors_.shape == (12, 12)
+    assert fitted.label_features_.shape == (2, 6)
+    assert fitted.style_factors_.shape == (6, 12)
     assert np.shares_memory(fitted.hidden_factors_, layer.flat)
     assert not hasattr(fitted, "style_hidden_")  # shared: one matrix
     separate = small_model(shared_style_weights=False, n_iter=2)
     X, ids, styles = styled_data()
     separate.fit(X, styles, sequence_ids=ids)
-    assert separate.style_hidden_.shape == (3, 6)
+    assert separate.style_hidden_.shape == (6, 12)
     assert separate._layer.flat.size > fitted._layer.flat.size
 
 
@@ -224,6 +224,113 @@ def test_partial_fit_and_float32(fitted):
     assert model.sample(5, style="low", n_gibbs=2).dtype == np.float32
     with pytest.raises(ValueError, match="not seen in fit"):
         model.partial_fit(X, np.full(len(X), "other"), sequence_ids=ids)
+
+
+def test_start_values_are_the_released_codes():
+    """Every weight from 0.01 N(0, 1) in the order of the groups (R too), biases 0."""
+    from sklearn_crbm._factored_layer import FactoredLayer
+
+    layer = FactoredLayer(5, 7, 4, 3, 2, 2, np.float64).initialize(
+        np.random.default_rng(0)
+    )
+    rng = np.random.default_rng(0)
+    for group in layer.groups:
+        value = getattr(layer, group.name)
+        if group.decayed:
+            assert_array_equal(value, 0.01 * rng.standard_normal(value.shape))
+        else:
+            assert_array_equal(value, 0.0)
+    assert layer.label_features.shape == (2, 3)
+
+
+def test_learning_rates_per_group_and_momentum_are_the_released_codes():
+    """A tenth of the rate for past->visible factors and R; the rest in full,
+    past->hidden and style->factor weights included; momentum 0.9 from epoch 6."""
+    from sklearn_crbm._factored_layer import FactoredLayer
+    from sklearn_crbm._training import Schedule
+
+    for shared in (True, False):
+        layer = FactoredLayer(5, 7, 4, 3, 2, 2, np.float64, shared_style_weights=shared)
+        rates = layer.views(layer.rates())
+        tenth = {"past_visible_factors", "visible_from_factors", "label_features"}
+        for name, rate in rates.items():
+            assert_array_equal(rate, 0.1 if name in tenth else 1.0)
+    schedule = Schedule.of(FactoredCRBM())
+    assert [schedule.momentum_at(done) for done in (0, 4, 5, 199)] == [0, 0, 0.9, 0.9]
+
+
+def _bounded_update(max_step, statistics):
+    """One momentum step of a small layer, bounded; ``(before, after, update)``."""
+    from sklearn_crbm._factored_layer import FactoredLayer
+    from sklearn_crbm._parameters import MomentumUpdate
+    from sklearn_crbm._training import StepBound
+
+    layer = FactoredLayer(5, 7, 4, 3, 2, 2, np.float64)
+    layer.initialize(np.random.default_rng(0))
+    before = layer.copy()
+    update = StepBound(MomentumUpdate(layer), max_step)
+    for name, value in statistics.items():
+        getattr(update.statistics, name)[...] = value
+    update.apply(0.9, 0.01, 0.0)
+    return before, layer, update
+
+
+def test_step_bound_scales_down_only_the_steps_beyond_it():
+    huge, small = 100.0, 1e-6
+    before, after, update = _bounded_update(
+        0.25,
+        {"style_factors": huge, "visible_factors": small, "hidden_bias": huge},
+    )
+    velocity = update.velocity
+    for name in ("style_factors", "visible_factors", "hidden_bias"):
+        assert_allclose(
+            getattr(after, name) - getattr(before, name), getattr(velocity, name)
+        )
+    limit = 0.25 * np.linalg.norm(before.style_factors)
+    assert_allclose(np.linalg.norm(velocity.style_factors), limit)
+    assert_allclose(velocity.visible_factors, small)  # within the bound: as it was
+    assert_allclose(velocity.hidden_bias, huge)  # biases are not bounded
+
+
+def test_step_bound_keeps_training_from_running_away(data_home):
+    """Bandai walks, a learning rate 20 times the default: the three-way
+    weights run away within a few epochs of momentum, unless bounded."""
+    import sklearn
+
+    from sklearn_crbm._training import TrainingDivergedError
+    from sklearn_crbm.datasets import load_bandai_walks
+    from sklearn_crbm.preprocessing import make_motion_preprocessor
+
+    walks = load_bandai_walks(data_home)
+    train = walks.takes[walks.sequence_ids] <= 5
+    X, ids = walks.data[train], walks.sequence_ids[train]
+    with sklearn.config_context(enable_metadata_routing=True):
+        Z = make_motion_preprocessor(walks.skeleton).fit_transform(X, sequence_ids=ids)
+    styles = walks.target_names[walks.target[train]]
+    params = dict(n_factors=50, n_style_features=20, cd_steps=1, learning_rate=0.2)
+    params.update(momentum_delay=2, n_iter=10, random_state=0)
+    with pytest.raises(TrainingDivergedError, match="Lower the learning rate, and"):
+        FactoredCRBM(100, max_step=None, **params).fit(Z, styles, sequence_ids=ids)
+    model = FactoredCRBM(100, **params).fit(Z, styles, sequence_ids=ids)
+    # finite, and learning: the untrained reconstruction error is 64
+    assert model._layer.is_finite() and model.reconstruction_error_ < 52
+
+
+def test_divergence_says_what_to_change():
+    from sklearn_crbm._training import Schedule, _divergence_message
+
+    schedule = Schedule.of(FactoredCRBM(learning_rate=0.3))
+    message = _divergence_message(schedule, 7)
+    assert message.startswith("Training diverged at epoch 7")
+    for advice in (
+        "learning_rate=0.3",
+        "Lower the learning rate",
+        "max_step (now 0.25)",
+    ):
+        assert advice in message
+    assert "max_step" not in _divergence_message(
+        Schedule(**{**vars(schedule), "max_step": None}), 7
+    )
 
 
 @pytest.mark.parametrize("ramp", [5, 0])

@@ -151,7 +151,7 @@ def test_paper_settings_stay_finite_on_cmu35(dtype, cmu_preprocessed, factories)
 # The style models at sizes a user of the CMU data would start from, walks
 # and jogs labelled; few annealing steps, which the checks do not need.
 STYLE_SETTINGS = {
-    "factored": dict(n_components=200, n_factors=100, n_style_features=50, n_iter=10),
+    "factored": dict(n_components=200, n_factors=100, n_style_features=50, n_iter=40),
     "labelled": dict(n_components=200, n_iter=25),
 }
 
