@@ -20,9 +20,8 @@ from sklearn.utils import Bunch
 from ._base import generated_liveliness
 from ._cli_options import COMMANDS, MAX_DEFAULT_RATE
 from ._crbm import ConditionalRBM
-from ._demo import liveliness_text
+from ._demo import liveliness_text, save_gif
 from ._demo import run_demo as _run_demo
-from ._demo import save_gif
 from ._factored import FactoredCRBM
 from ._style_demo import run_styles as _run_styles
 from .datasets import (
