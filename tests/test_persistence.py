@@ -19,6 +19,7 @@ first (see ``sklearn_crbm/utils/_persistence.py``)::
 """
 
 import io
+import json
 import pickle
 import sys
 import types
@@ -55,7 +56,7 @@ from sklearn_crbm.utils._persistence import PICKLE_FORMAT, VersionedPickleMixin
 
 DATA = Path(__file__).parent / "data"
 STORED = DATA / f"pickle_format{PICKLE_FORMAT}.pkl"
-STORED_OUTPUTS = DATA / f"pickle_format{PICKLE_FORMAT}_outputs.npz"
+STORED_OUTPUTS = DATA / f"pickle_format{PICKLE_FORMAT}_outputs.json"
 
 X_OSC, IDS_OSC = make_oscillations(n_sequences=4, n_frames=40, random_state=0)
 WALKER = make_walker(n_sequences=2, n_frames=40, random_state=0)
@@ -404,15 +405,24 @@ def _write_stored():
         for i, output in enumerate(_model_outputs(model, X, ids, styles)):
             outputs[f"{name}_{i}"] = output
     STORED.write_bytes(pickle.dumps(models))
-    np.savez_compressed(STORED_OUTPUTS, **outputs)
+    # JSON: Python's float repr gives every float32 and float64 back exactly
+    arrays = {
+        key: {"dtype": str(a.dtype), "shape": a.shape, "values": a.ravel().tolist()}
+        for key, a in ((key, np.asarray(a)) for key, a in outputs.items())
+    }
+    STORED_OUTPUTS.write_text(json.dumps(arrays))
 
 
 @pytest.fixture(scope="module")
 def stored():
     """The stored models, loaded, and the outputs they gave when saved."""
     models = pickle.loads(STORED.read_bytes())
-    with np.load(STORED_OUTPUTS) as outputs:
-        return models, dict(outputs)
+    arrays = json.loads(STORED_OUTPUTS.read_text())
+    outputs = {
+        key: np.array(a["values"], dtype=a["dtype"]).reshape(a["shape"])
+        for key, a in arrays.items()
+    }
+    return models, outputs
 
 
 @pytest.mark.parametrize("name", list(_stored_models()))
