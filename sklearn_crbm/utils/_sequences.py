@@ -50,13 +50,33 @@ class _LoadedSequences:
         forget = lambda _, key=key: _KNOWN_SEQUENCES.pop(key, None)  # noqa: E731
         self.reference = weakref.ref(X, forget)
         self.sequence_ids = np.asarray(sequence_ids)
-        self._row_index = None
+        self._sorted = None
 
-    def row_index(self, data):
-        """Each row's bytes -> its position, built on the first look-up."""
-        if self._row_index is None:
-            self._row_index = {row.tobytes(): i for i, row in enumerate(data)}
-        return self._row_index
+    def rows_of(self, data, X):
+        """The row of ``data`` equal to each row of ``X`` (-1 where none),
+        matched by a 64-bit hash of the rows' bytes: 16 bytes a row of
+        ``data``, built on the first look-up."""
+        if self._sorted is None:
+            hashes = _row_hashes(data)
+            order = np.argsort(hashes, kind="stable")
+            self._sorted = hashes[order], order
+        hashes, order = self._sorted
+        wanted = _row_hashes(X)
+        at = np.minimum(np.searchsorted(hashes, wanted), len(hashes) - 1)
+        return np.where(hashes[at] == wanted, order[at], -1)
+
+
+def _row_hashes(X):
+    """A 64-bit hash of the bytes of every row (multiply and add, mod 2**64)."""
+    rows = np.ascontiguousarray(X).view(np.uint8).reshape(len(X), -1)
+    padding = -rows.shape[1] % 8
+    if padding:
+        rows = np.pad(rows, ((0, 0), (0, padding)))
+    words = rows.view(np.uint64)
+    multipliers = np.random.default_rng(0).integers(
+        1, 2**63, size=words.shape[1], dtype=np.uint64
+    ) * np.uint64(2) + np.uint64(1)
+    return (words * multipliers).sum(axis=1, dtype=np.uint64)
 
 
 def remember_sequences(X, sequence_ids):
@@ -81,16 +101,15 @@ def _viewed_loader_ids(X):
 def _copied_loader_ids(X):
     """The loader's sequence id of every row of ``X``, where each row of ``X``
     is a row of a loader's array (a cross-validation fold, a selection)."""
+    probe = np.unique(np.linspace(0, len(X) - 1, _PROBE_ROWS).astype(np.intp))
     for entry in list(_KNOWN_SEQUENCES.values()):
         data = entry.reference()
         if data is None or data.shape[1:] != X.shape[1:] or data.dtype != X.dtype:
             continue
-        index = entry.row_index(data)
-        probe = np.unique(np.linspace(0, len(X) - 1, _PROBE_ROWS).astype(np.intp))
-        if any(X[i].tobytes() not in index for i in probe):
+        if (entry.rows_of(data, X[probe]) < 0).any():
             continue
-        rows = [index.get(row.tobytes()) for row in X]
-        if None not in rows:
+        rows = entry.rows_of(data, X)
+        if (rows >= 0).all():
             return entry.sequence_ids[rows], entry.sequence_ids
     return None
 
