@@ -12,6 +12,13 @@ matrix product::
 
     [c_hat, b_hat] = history @ dynamic.T + [c, b]
 
+A per-frame context ``y_t`` (``n_context`` real values: a control signal,
+or label weights) adds to both through the weights ``context_weights`` of
+shape ``(n_features + n_components, n_context)``, stacked as ``dynamic``
+is::
+
+    [c_hat, b_hat] = history @ dynamic.T + [c, b] + y_t @ context_weights.T
+
 When ``order != hidden_order`` the blocks of lags a group does not use are
 kept at exactly zero.  Every frame shares ``W``: the frame RBMs differ in
 their biases only.  The paper fixes the visible standard deviation ``s`` at
@@ -74,6 +81,13 @@ CRBM_GROUPS = (
         lambda p: (p.n_features,),
         lambda p, rng: np.zeros(p.n_features, p.dtype),
         decayed=False,
+    ),
+    # last: without context it is empty and draws nothing
+    ParameterGroup(
+        "context_weights",
+        lambda p: (p.n_features + p.n_components, p.n_context),
+        lambda p, rng: small_normal(rng, p.context_weights.shape, p.dtype),
+        decayed=True,
     ),
 )
 
@@ -154,13 +168,16 @@ class CRBMLayer(ConditionalLayer):
     n_features), ``hidden_bias`` (n_components,), ``visible_bias``
     (n_features,), ``dynamic`` (n_features + n_components, n_lags *
     n_features), the directed weights ``[A; B]`` (see the module docstring),
-    and ``log_visible_variance`` (n_features,).
+    ``log_visible_variance`` (n_features,) and ``context_weights``
+    (n_features + n_components, n_context).
 
     Parameters
     ----------
     n_features, n_components, order, hidden_order : int
     visible_type : {"gaussian", "binary"}
     dtype : dtype
+    n_context : int, default=0
+        Columns of the per-frame context.
     flat : ndarray of shape (n_parameters,), default=None
         The buffer to view; zeros if None.
     layout : {"C", "F"}, default="C"
@@ -178,6 +195,8 @@ class CRBMLayer(ConditionalLayer):
     """
 
     groups = CRBM_GROUPS
+    # layers pickled before contexts had none
+    n_context = 0
 
     def __init__(
         self,
@@ -188,6 +207,7 @@ class CRBMLayer(ConditionalLayer):
         visible_type,
         dtype,
         *,
+        n_context=0,
         flat=None,
         layout="C",
         learned_variance=False,
@@ -200,6 +220,7 @@ class CRBMLayer(ConditionalLayer):
         self.order = order
         self.hidden_order = hidden_order
         self.visible_type = visible_type
+        self.n_context = n_context
         self.learned_variance = learned_variance
         self.fixed_variance = fixed_variance
         self.centered = centered
@@ -246,6 +267,16 @@ class CRBMLayer(ConditionalLayer):
         block = self.dynamic[n:, : self.hidden_order * n]
         return _lag_blocks(block, self.hidden_order, n)
 
+    @property
+    def context_to_visible(self):
+        """``L_v``, shape ``(n_features, n_context)``: context to visible biases."""
+        return self.context_weights[: self.n_features, ...]
+
+    @property
+    def context_to_hidden(self):
+        """``L_h``, shape ``(n_components, n_context)``: context to hidden biases."""
+        return self.context_weights[self.n_features :, ...]
+
     def dynamic_mask(self):
         """1 where a directed weight exists, 0 on the lags a group does not use."""
         n = self.n_features
@@ -256,12 +287,12 @@ class CRBMLayer(ConditionalLayer):
 
     # --------------------------------------------------------- frame RBMs
 
-    def dynamic_biases(self, history, out=None, static=None):
-        """``c_hat`` and ``b_hat`` of each frame given its flattened history.
+    def dynamic_biases(self, history, context=None, out=None, static=None):
+        """``c_hat`` and ``b_hat`` of each frame given its history and context.
 
         Views of one array ``out`` of shape ``(n, n_features +
-        n_components)`` (one matrix product); ``static`` is ``[c, b]`` if
-        the caller keeps it at hand.
+        n_components)``; ``static`` is ``[c, b]`` if the caller keeps it at
+        hand.
         """
         n = self.n_features
         ops = self.ops
@@ -275,10 +306,12 @@ class CRBMLayer(ConditionalLayer):
         else:
             out = ops.matmul(history, self.dynamic.T, out=out)
             out += static
+        if self.n_context:
+            out += ops.matmul(context, self.context_weights.T)
         return out[:, :n], out[:, n:]
 
     def frame_rbms(self, history, context=None, *, out=None):
-        visible_bias, hidden_bias = self.dynamic_biases(history, out=out)
+        visible_bias, hidden_bias = self.dynamic_biases(history, context, out=out)
         return CRBMFrames(
             visible_bias, hidden_bias, self.visible_std, self.binary, self.weights
         )
@@ -290,7 +323,9 @@ class CRBMLayer(ConditionalLayer):
         input_weights = self.weights if std is None else self.weights / std
 
         def frame_rbms(history, context=None):
-            visible_bias, hidden_bias = self.dynamic_biases(history, static=static)
+            visible_bias, hidden_bias = self.dynamic_biases(
+                history, context, static=static
+            )
             return CRBMFrames(
                 visible_bias, hidden_bias, std, self.binary, self.weights, input_weights
             )
@@ -360,8 +395,8 @@ class CRBMLayer(ConditionalLayer):
         change of the visible mean (Montavon & Müller's centring, Cho, Raiko
         & Ilin's enhanced gradient).
 
-        ``context`` goes to :meth:`frame_rbms` (which ignores it: a CRBM has
-        no context).
+        The context weights' statistics are those of the directed weights
+        with the context in place of the history.
         """
         n, d = visible.shape
         ops = self.ops
@@ -444,6 +479,8 @@ class CRBMLayer(ConditionalLayer):
             ops.matmul(delta.T, history, out=out.dynamic)
             if workspace.dynamic_mask is not None:
                 out.dynamic *= workspace.dynamic_mask
+        if self.n_context:
+            out.context_weights[...] = ops.matmul(delta.T, context)
         return out, squared_error
 
     def _centre_statistics(self, std, visible_bias, delta, d, scale, out):
@@ -480,11 +517,12 @@ def shift_centred(layer, direction):
     """Move ``layer`` in place to centred coordinates (``+1``) or back (``-1``).
 
     In centred coordinates the hidden units see the residual against the
-    dynamic visible bias, ``b' + B' x_past + W ((v - c_hat) / s)``: the same
-    model as the standard form ``b + B x_past + W (v / s)`` with ``b = b' -
-    W (c / s)`` and ``B_q = B'_q - W diag(1 / s) A_q``, where ``c`` and
-    ``A`` are the static visible bias and the autoregressive weights.
-    Needs ``hidden_order >= order``.
+    dynamic visible bias, ``b' + B' x_past + L'_h y + W ((v - c_hat) / s)``:
+    the same model as the standard form ``b + B x_past + L_h y + W (v / s)``
+    with ``b = b' - W (c / s)``, ``B_q = B'_q - W diag(1 / s) A_q`` and
+    ``L_h = L'_h - W diag(1 / s) L_v``, where ``c``, ``A`` and ``L_v`` are
+    the static visible bias, the autoregressive and the context-to-visible
+    weights.  Needs ``hidden_order >= order``.
     """
     ops = layer.ops
     n = layer.n_features
@@ -497,6 +535,11 @@ def shift_centred(layer, direction):
     if width:
         shift = ops.matmul(weights, layer.dynamic[:n, :width])
         layer.dynamic[n:, :width] = layer.dynamic[n:, :width] + direction * shift
+    if layer.n_context:
+        shift = ops.matmul(weights, layer.context_weights[:n, ...])
+        layer.context_weights[n:, ...] = layer.context_weights[n:, ...] + (
+            direction * shift
+        )
     return layer
 
 

@@ -312,6 +312,13 @@ class ConditionalLayer(PackedParameters):
     def new_workspace(self, batch_size):
         return TrainingWorkspace(self, batch_size)
 
+    def __setstate__(self, state):
+        # layers pickled before real-valued contexts named their width n_classes
+        state = dict(state)
+        if "n_classes" in state and "n_context" not in state:
+            state["n_context"] = state.pop("n_classes")
+        super().__setstate__(state)
+
     def cd_statistics(
         self, visible, history, context, cd_steps, rng, *, out, scale, workspace
     ):

@@ -497,15 +497,19 @@ def _fill(
         clamp = ops.broadcast_to(~frame_missing, shape)
         current = ops.broadcast_to(frames, shape)
         if history is None:
+            # the first frame's context is its past's (the chains' own, else)
+            past_context = chain_context
+            if context is not None:
+                past_context = ops.broadcast_to(context, (n_chains, *context.shape))
             if drawn.any():
                 # No past: the frame stands in for it, and the fill is
                 # repeated with the latest fill as the past.
                 for _ in range(FIRST_FRAME_ROUNDS):
                     own_past = History.from_frames(
-                        layers, current[:, :, None, :], chain_context
+                        layers, current[:, :, None, :], past_context
                     )
                     current = draw(current, own_past.frame_rbms(context), clamp)[0]
-            history = History.from_frames(layers, current[:, :, None, :], chain_context)
+            history = History.from_frames(layers, current[:, :, None, :], past_context)
             yield step, current
             continue
         # with a context of their own the chains' every observation is

@@ -85,6 +85,8 @@ class StackedCRBM(BaseCRBM):
     ----------
     layers_ : list of ConditionalRBM
         The fitted layers, bottom (Gaussian visibles) first.
+    n_context_ : int
+        Columns of the context the stack was fitted with (0: none).
     seed_windows_ : ndarray of shape (n_windows, history_length, n_features)
         Windows of consecutive training frames kept to seed :meth:`sample`.
     random_state_ : RandomState instance
@@ -248,7 +250,7 @@ class StackedCRBM(BaseCRBM):
             **{name: params[name] for name in self._layer_parameters},
         )
 
-    def _check_fit_input(self, X, sequence_ids, reset):
+    def _check_fit_input(self, X, sequence_ids, context, reset):
         xp = get_namespace(X)[0]
         if not reset:
             self._check_namespace(X, "partial_fit")
@@ -270,19 +272,23 @@ class StackedCRBM(BaseCRBM):
                 f"but the longest sequence has {longest} {noun}. Pass longer "
                 "sequences (check sequence_ids), fewer layers or a lower order."
             )
-        return X, sequences
+        return X, sequences, self._fit_context(X, None, context, reset)
 
-    def _pass_up(self, layer, X, ids):
-        """Hidden probabilities of ``layer`` on its valid frames, with their ids."""
+    def _pass_up(self, layer, X, ids, context):
+        """Hidden probabilities of ``layer`` on its valid frames, with their ids
+        and contexts."""
         valid = check_sequence_ids(ids, X.shape[0]).valid_frames(layer._n_lags)
-        hidden = layer.transform(X, sequence_ids=ids)
-        return array_ops(hidden).take(hidden, valid, axis=0), ids[valid]
+        hidden = layer.transform(X, sequence_ids=ids, context=context)
+        ops = array_ops(hidden)
+        if context is not None:
+            context = ops.take(context, valid, axis=0)
+        return ops.take(hidden, valid, axis=0), ids[valid], context
 
     # ------------------------------------------------------------------ fit
 
     @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y=None, *, sequence_ids=None):
+    def fit(self, X, y=None, *, sequence_ids=None, context=None):
         """Train the layers greedily, bottom first.
 
         Parameters
@@ -293,6 +299,9 @@ class StackedCRBM(BaseCRBM):
             Ignored.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's real-valued context, which every layer adds to its
+            dynamic biases (see :class:`ConditionalRBM`).
 
         Returns
         -------
@@ -301,7 +310,9 @@ class StackedCRBM(BaseCRBM):
         """
         sizes = self._layer_sizes()
         noises = self._history_noises(len(sizes))
-        X, sequences = self._check_fit_input(X, sequence_ids, reset=True)
+        X, sequences, context = self._check_fit_input(
+            X, sequence_ids, context, reset=True
+        )
         self.random_state_ = check_random_state(self.random_state)
         ids = sequences.per_frame_ids()
         self.layers_ = []
@@ -311,16 +322,16 @@ class StackedCRBM(BaseCRBM):
             layer = self._new_layer(
                 size, "gaussian" if k == 0 else "binary", seed, noises[k]
             )
-            layer.fit(data, sequence_ids=ids)
+            layer.fit(data, sequence_ids=ids, context=context)
             self.layers_.append(layer)
             if k + 1 < len(sizes):
-                data, ids = self._pass_up(layer, data, ids)
+                data, ids, context = self._pass_up(layer, data, ids, context)
         self._keep_seeds(X, sequences)
         return self
 
     @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
-    def partial_fit(self, X, y=None, *, sequence_ids=None):
+    def partial_fit(self, X, y=None, *, sequence_ids=None, context=None):
         """Train every layer for one epoch on the given sequences.
 
         The first call creates the layers.  Each call trains the bottom
@@ -336,6 +347,9 @@ class StackedCRBM(BaseCRBM):
             Ignored.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's real-valued context, which every layer adds to its
+            dynamic biases (see :class:`ConditionalRBM`).
 
         Returns
         -------
@@ -345,7 +359,9 @@ class StackedCRBM(BaseCRBM):
         sizes = self._layer_sizes()
         noises = self._history_noises(len(sizes))
         first_call = not hasattr(self, "layers_")
-        X, sequences = self._check_fit_input(X, sequence_ids, reset=first_call)
+        X, sequences, context = self._check_fit_input(
+            X, sequence_ids, context, reset=first_call
+        )
         if first_call:
             self.random_state_ = check_random_state(self.random_state)
             self.layers_ = [
@@ -360,9 +376,9 @@ class StackedCRBM(BaseCRBM):
         ids = sequences.per_frame_ids()
         data = X
         for k, layer in enumerate(self.layers_):
-            layer.partial_fit(data, sequence_ids=ids)
+            layer.partial_fit(data, sequence_ids=ids, context=context)
             if k + 1 < len(self.layers_):
-                data, ids = self._pass_up(layer, data, ids)
+                data, ids, context = self._pass_up(layer, data, ids, context)
         self._keep_seeds(X, sequences, merge=True)
         return self
 

@@ -44,8 +44,8 @@ def test_fit_learns_the_styles(fitted):
     assert fitted.n_iter_ == 400 and fitted._layer.is_finite()
     X, ids, styles = styled_data(random_state=1)
     flipped = np.where(styles == "low", "high", "low")
-    right = fitted.predict_next(X, styles, sequence_ids=ids)
-    wrong = fitted.predict_next(X, flipped, sequence_ids=ids)
+    right = fitted.predict_next(X, style=styles, sequence_ids=ids)
+    wrong = fitted.predict_next(X, style=flipped, sequence_ids=ids)
     assert np.mean((X - right)[:, 0] ** 2) < 0.25 * np.mean((X - wrong)[:, 0] ** 2)
     assert fitted.score(X, styles, sequence_ids=ids) > fitted.score(
         X, flipped, sequence_ids=ids
@@ -114,10 +114,10 @@ def test_score_samples_is_exact_for_a_tiny_model():
     layer.flat[...] = 0.5 * rng.standard_normal(layer.flat.shape)
     weights = rng.dirichlet([1, 1], size=len(X))  # blends, frame by frame
     expected = exact_log_likelihood(model, X, ids, weights)
-    assert_allclose(model.score_samples(X, weights, sequence_ids=ids), expected)
+    assert_allclose(model.score_samples(X, style=weights, sequence_ids=ids), expected)
     one_hot = np.eye(2)[np.searchsorted(model.classes_, styles)]
     assert_allclose(
-        model.score_samples(X, styles, sequence_ids=ids),
+        model.score_samples(X, style=styles, sequence_ids=ids),
         exact_log_likelihood(model, X, ids, one_hot),
     )
     # annealing agrees with enumeration to within its error

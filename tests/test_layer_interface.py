@@ -24,7 +24,7 @@ from sklearn_crbm.impute import CRBMImputer
 
 CONTEXT_GROUPS = CRBM_GROUPS + (
     ParameterGroup(
-        "context_weights",
+        "label_weights",
         lambda p: (p.n_components, p.n_classes),
         lambda p, rng: small_normal(rng, (p.n_components, p.n_classes), p.dtype),
         decayed=True,
@@ -43,7 +43,7 @@ class ContextLayer(CRBMLayer):
 
     def frame_rbms(self, history, context=None, *, out=None):
         rbms = super().frame_rbms(history, out=out)
-        rbms.hidden_bias += self.ops.matmul(context, self.context_weights.T)
+        rbms.hidden_bias += self.ops.matmul(context, self.label_weights.T)
         return rbms
 
     def conditioner(self):
@@ -55,7 +55,7 @@ class ContextLayer(CRBMLayer):
         )
         n = visible.shape[0]
         hidden_delta = kwargs["workspace"].delta[:n, self.n_features :]  # scaled
-        out.context_weights[...] = self.ops.matmul(hidden_delta.T, context)
+        out.label_weights[...] = self.ops.matmul(hidden_delta.T, context)
         return out, error
 
 
@@ -119,10 +119,8 @@ class ContextCRBM(BaseStyleModel):
     def _hidden_order(self):
         return self.order
 
-    def _new_layer(self, n_features, dtype):
-        return ContextLayer(
-            n_features, self.n_components, len(self.classes_), self.order, dtype
-        )
+    def _new_layer(self, n_features, n_context, dtype):
+        return ContextLayer(n_features, self.n_components, n_context, self.order, dtype)
 
 
 def styled_data(random_state=0, switching=True, n_sequences=8):
@@ -142,13 +140,13 @@ def test_it_trains(fitted):
     assert fitted.n_iter_ == 100 and layer.is_finite()
     assert_array_equal(fitted.classes_, ["high", "low"])
     # the context weights moved from their small start, and apart by style
-    difference = layer.context_weights[:, 0] - layer.context_weights[:, 1]
+    difference = layer.label_weights[:, 0] - layer.label_weights[:, 1]
     assert np.abs(difference).max() > 0.1
     X, ids, styles = styled_data(random_state=1)
     # one-step predictions given the right style beat those given the wrong one
-    right = fitted.predict_next(X, styles, sequence_ids=ids)
+    right = fitted.predict_next(X, style=styles, sequence_ids=ids)
     wrong = fitted.predict_next(
-        X, np.where(styles == "low", "high", "low"), sequence_ids=ids
+        X, style=np.where(styles == "low", "high", "low"), sequence_ids=ids
     )
     assert np.mean((X - right)[:, 0] ** 2) < 0.25 * np.mean((X - wrong)[:, 0] ** 2)
     X, ids, styles = styled_data(random_state=1, switching=False)
@@ -176,7 +174,7 @@ def exact_log_likelihood(layer, X, ids, labels):
     the visibles integrate in closed form for each ``h``.
     """
     d, order = layer.n_features, layer.order
-    W, C = layer.weights, layer.context_weights
+    W, C = layer.weights, layer.label_weights
     A, B = layer.dynamic[:d], layer.dynamic[d:]
     states = np.array(list(itertools.product([0, 1], repeat=layer.n_components)))
     result = []
@@ -201,16 +199,17 @@ def test_it_scores_exactly():
     model = ContextCRBM(4, n_iter=20, random_state=0).fit(X, styles, sequence_ids=ids)
     rng = np.random.default_rng(0)
     layer = model._layer
-    layer.context_weights[...] = rng.standard_normal(layer.context_weights.shape)
+    layer.label_weights[...] = rng.standard_normal(layer.label_weights.shape)
     labels = np.eye(2)[np.searchsorted(model.classes_, styles)]
     expected = exact_log_likelihood(layer, X, ids, labels)
-    got = model.score_samples(X, styles, sequence_ids=ids)
+    got = model.score_samples(X, style=styles, sequence_ids=ids)
     assert_allclose(got, expected, rtol=1e-9, atol=1e-9)
     # the style unknown: each frame's mixture over the styles, weighted by
     # their posterior given the frames before it in its sequence
     X, ids, styles = styled_data(random_state=1, switching=False)
     per_style = np.stack(
-        [model.score_samples(X, s, sequence_ids=ids) for s in model.classes_], axis=1
+        [model.score_samples(X, style=s, sequence_ids=ids) for s in model.classes_],
+        axis=1,
     )
     mixture = model.score_samples(X, sequence_ids=ids)
     for sequence in np.unique(ids):
