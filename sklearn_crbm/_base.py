@@ -23,6 +23,7 @@ from sklearn.utils._array_api import check_same_namespace, get_namespace
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import (
     _check_sample_weight,
+    _is_fitted,
     check_is_fitted,
     validate_data,
 )
@@ -106,8 +107,6 @@ class BaseCRBM(
     """
 
     _parameter_constraints: dict = {
-        "order": [Interval(Integral, 0, None, closed="left")],
-        "hidden_order": [None, Interval(Integral, 0, None, closed="left")],
         "learning_rate": [Interval(Real, 0, None, closed="neither")],
         "momentum": [Interval(Real, 0, 1, closed="left")],
         "momentum_delay": [Interval(Integral, 0, None, closed="left")],
@@ -134,14 +133,38 @@ class BaseCRBM(
 
     # ---------------------------------------------------------------- hooks
 
-    @property
-    @abstractmethod
-    def history_length(self):
-        """Past frames a frame's top-layer representation depends on."""
-
     @abstractmethod
     def _layers(self):
         """The fitted :class:`~sklearn_crbm._layer.ConditionalLayer` s, bottom first."""
+
+    @abstractmethod
+    def _planned_layers(self, n_features):
+        """The layers ``fit`` would make for ``n_features`` (not initialised)."""
+
+    @property
+    def history_length(self):
+        """Past frames a frame's top-layer representation depends on.
+
+        The sum of the layers' past frames (``max(order, hidden_order)``
+        each; before fit, those of the layers ``fit`` would make):
+        :meth:`sample` needs this many seed frames (at least one), and
+        :meth:`score` judges frames with this many past frames in their
+        sequence.
+        """
+        # the past a layer takes does not depend on its number of features
+        layers = self._layers() if _is_fitted(self) else self._planned_layers(1)
+        return sum(layer.n_lags for layer in layers)
+
+    def _matrix_product_size(self, n_features=None):
+        """Multiply-adds per frame of the largest matrix product of the layers.
+
+        Those fitted, or (``n_features`` given, before the first fit) those
+        ``fit`` would make; the package sizes its BLAS threads by it
+        (:mod:`sklearn_crbm.utils._threads`).
+        """
+        fitted = _is_fitted(self)
+        layers = self._layers() if fitted else self._planned_layers(n_features)
+        return max(layer.product_size() for layer in layers)
 
     def _ais_settings(self):
         """Intermediate distributions and chains per frame of the annealing."""
@@ -183,10 +206,6 @@ class BaseCRBM(
     def _chain_rng(self, rng):
         """The generator of ``sample``'s chains, given the one that picked seeds."""
         return rng
-
-    @property
-    def _hidden_order(self):
-        return self.order if self.hidden_order is None else self.hidden_order
 
     @property
     def n_context_(self):
@@ -242,11 +261,6 @@ class BaseCRBM(
 
     # how else a model can be told its context
     _context_hint = ""
-
-    @property
-    def _n_lags(self):
-        """Past frames of one layer: ``max(order, hidden_order)``."""
-        return max(self.order, self._hidden_order)
 
     # ------------------------------------------------------------------ fit
 
@@ -521,7 +535,6 @@ n_classes), default=None
             return frame_log_likelihood(
                 X,
                 sequence_frame_rbms(layers[0], X, sequences, context=context),
-                shared=layers[0].n_lags == 0 and context is None,
                 method=method,
                 n_steps=n_steps,
                 n_chains=n_chains,
@@ -858,6 +871,46 @@ default=None
             block_size=SAMPLE_BLOCK if ops is np else seed.shape[0],
         )
         return ops.reshape(ops.concatenate(blocks), (-1, self.n_features_in_))
+
+    # ------------------------------------------------------ on-line fill-in
+
+    def conditional_layers(self):
+        """The fitted conditional layers, bottom first: what on-line fill-in runs.
+
+        Returns
+        -------
+        layers : list of ConditionalLayer
+            One for a one-layer model, one per layer for a stack (see
+            :mod:`sklearn_crbm._layer` for their interface).
+        """
+        check_is_fitted(self)
+        return list(self._layers())
+
+    def fill_in_context(self, X, *, context=None, style=None):
+        """What on-line fill-in of the frames ``X`` conditions on.
+
+        Parameters
+        ----------
+        X : ndarray of shape (n_frames, n_features)
+            The frames, checked, in the namespace of the model.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context, as in :meth:`transform`.
+        style : label or array-like, default=None
+            A style model's labels in place of ``context``.
+
+        Returns
+        -------
+        frame_context : ndarray of shape (n_frames, n_context) or None
+            Every frame's context, given (or from ``style``); None for a
+            model without one, or where it is to be inferred.
+        hypotheses : ndarray of shape (n_hypotheses, n_context) or None
+            With ``frame_context`` None, the contexts that the particles of
+            a filter carry and resampling weighs (a style model fitted on
+            labels: one per style); else None.
+        """
+        check_is_fitted(self)
+        context = self._method_context(context, style, X.shape[0], X)
+        return self._online_context(X, context)
 
     # ---------------------------------------------------------------- misc
 

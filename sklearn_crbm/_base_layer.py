@@ -186,18 +186,11 @@ class BaseLayerModel(BaseCRBM):
         self._keep_seeds(X, sequences, merge=True)
         return self
 
-    @property
-    def history_length(self):
-        """Past frames a frame depends on: ``max(order, hidden_order)``.
-
-        :meth:`sample` needs this many seed frames (at least one), and
-        :meth:`score` judges frames with this many past frames in their
-        sequence.
-        """
-        return self._n_lags
-
     def _layers(self):
         return [self._layer]
+
+    def _planned_layers(self, n_features):
+        return [self._new_layer(n_features, 0, np.float64)]
 
     def _n_epochs(self, n_frames):
         """The epochs ``fit`` trains on ``n_frames`` trainable frames.
@@ -218,14 +211,15 @@ class BaseLayerModel(BaseCRBM):
         """Validate ids and data; return the sequences and trainable frames."""
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
         self._check_training_data(X)
-        frames = sequences.valid_frames(self._n_lags)
+        n_lags = self._planned_layers(X.shape[1])[0].n_lags
+        frames = sequences.valid_frames(n_lags)
         if len(frames) == 0:
             longest = int(sequences.lengths.max()) if len(sequences.lengths) else 0
             noun = "sample" if longest == 1 else "samples"
             raise ValueError(
-                f"No frame has {self._n_lags} past frames in its own sequence: the "
+                f"No frame has {n_lags} past frames in its own sequence: the "
                 f"longest sequence has {longest} {noun}, but a model of order "
-                f"{self._n_lags} needs sequences of at least {self._n_lags + 1} "
+                f"{n_lags} needs sequences of at least {n_lags + 1} "
                 "frames. Pass longer sequences (check sequence_ids) or lower order."
             )
         return sequences, frames
@@ -279,12 +273,12 @@ class BaseLayerModel(BaseCRBM):
         parts = []
         for mask in (~held, held):
             part = check_sequence_ids(ids[mask], int(mask.sum()))
-            frames = part.valid_frames(self._n_lags)
+            frames = part.valid_frames(self.history_length)
             if len(frames) == 0:
                 raise ValueError(
                     f"early_stopping: no {'validation' if mask is held else 'training'}"
-                    f" frame has {self._n_lags} past frames in its sequence; pass "
-                    "longer sequences or raise validation_fraction."
+                    f" frame has {self.history_length} past frames in its sequence; "
+                    "pass longer sequences or raise validation_fraction."
                 )
             rows = np.flatnonzero(mask)
             part_context = None if context is None else ops.take(context, rows, axis=0)

@@ -11,7 +11,12 @@ from sklearn.utils._param_validation import Interval, StrOptions
 
 from ._base import FittedParameter
 from ._base_layer import BaseLayerModel
-from ._crbm_layer import MIN_LOG_VARIANCE, CRBMLayer
+from ._crbm_layer import (
+    MIN_LOG_VARIANCE,
+    ORDER_CONSTRAINTS,
+    CRBMLayer,
+    hidden_order_of,
+)
 from ._layer import BINARY
 from .utils._array_api import array_ops
 from .utils._autoregression import ridge_autoregression
@@ -166,6 +171,7 @@ class ConditionalRBM(BaseLayerModel):
 
     _parameter_constraints: dict = {
         **BaseLayerModel._parameter_constraints,
+        **ORDER_CONSTRAINTS,
         "n_components": [Interval(Integral, 1, None, closed="left")],
         "visible_type": [StrOptions({"gaussian", "binary"})],
         "visible_variance": [StrOptions({"unit", "learned", "residual"})],
@@ -300,7 +306,7 @@ class ConditionalRBM(BaseLayerModel):
             n_features,
             self.n_components,
             self.order,
-            self._hidden_order,
+            hidden_order_of(self),
             self.visible_type,
             dtype,
             n_context=n_context,
@@ -322,10 +328,10 @@ class ConditionalRBM(BaseLayerModel):
                 "visible mean and needs Gaussian visibles. Use centering=False "
                 "with binary visibles."
             )
-        if self.centering and self._hidden_order < self.order:
+        if self.centering and hidden_order_of(self) < self.order:
             raise ValueError(
                 f"centering=True needs hidden_order >= order (got hidden_order="
-                f"{self._hidden_order}, order={self.order}): the centred hidden "
+                f"{hidden_order_of(self)}, order={self.order}): the centred hidden "
                 "input is written back through the past-to-hidden weights of every "
                 "autoregressive lag. Raise hidden_order or use centering=False."
             )

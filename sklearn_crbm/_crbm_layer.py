@@ -27,15 +27,37 @@ their biases only.  The paper fixes the visible standard deviation ``s`` at
 """
 
 import math
+from numbers import Integral
 
 import numpy as np
+from sklearn.utils._param_validation import Interval
 
 from ._gibbs import HiddenSampler
 from ._layer import ConditionalLayer, FrameRBMs, TrainingWorkspace
 from ._parameters import ParameterGroup, small_normal
 from .utils._array_api import array_ops, same_memory
 
-__all__ = ["MIN_LOG_VARIANCE", "CRBMFrames", "CRBMLayer", "shift_centred"]
+__all__ = [
+    "MIN_LOG_VARIANCE",
+    "ORDER_CONSTRAINTS",
+    "CRBMFrames",
+    "CRBMLayer",
+    "hidden_order_of",
+    "shift_centred",
+]
+
+# The past frames of a CRBM: ``order`` feed the visibles, ``hidden_order``
+# (None: ``order``) the hidden units.
+ORDER_CONSTRAINTS = {
+    "order": [Interval(Integral, 0, None, closed="left")],
+    "hidden_order": [None, Interval(Integral, 0, None, closed="left")],
+}
+
+
+def hidden_order_of(model):
+    """A CRBM model's ``hidden_order``, None standing for its ``order``."""
+    return model.order if model.hidden_order is None else model.hidden_order
+
 
 # Learned visible variances are kept at or above 1e-4 (s >= 0.01, in the units
 # of standardised data): a channel that its past predicts almost exactly
@@ -97,7 +119,7 @@ class CRBMFrames(FrameRBMs):
 
     Parameters
     ----------
-    visible_bias, hidden_bias, visible_std, binary
+    visible_bias, hidden_bias, visible_std, units, frame_invariant
         As :class:`~sklearn_crbm._layer.FrameRBMs`.
     weights : ndarray of shape (n_components, n_features)
         ``W``.
@@ -112,11 +134,12 @@ class CRBMFrames(FrameRBMs):
         visible_bias,
         hidden_bias,
         visible_std,
-        binary,
+        units,
         weights,
         input_weights=None,
+        frame_invariant=False,
     ):
-        super().__init__(visible_bias, hidden_bias, visible_std, binary)
+        super().__init__(visible_bias, hidden_bias, visible_std, units, frame_invariant)
         self.weights = weights
         if input_weights is None:
             input_weights = weights if visible_std is None else weights / visible_std
@@ -301,36 +324,53 @@ class CRBMLayer(ConditionalLayer):
         # one contiguous add is several times faster than two on strided halves
         if static is None:
             static = ops.concatenate((self.visible_bias, self.hidden_bias))
-        if self.n_lags == 0:
+        inputs = self.bias_inputs(history, context)
+        if not inputs:
             out[...] = static
-        else:
-            out = ops.matmul(history, self.dynamic.T, out=out)
-            out += static
-        if self.n_context:
-            out += ops.matmul(context, self.context_weights.T)
+        for k, (name, values) in enumerate(inputs):
+            if k == 0:
+                out = ops.matmul(values, getattr(self, name).T, out=out)
+                out += static
+            else:
+                out += ops.matmul(values, getattr(self, name).T)
         return out[:, :n], out[:, n:]
 
-    def frame_rbms(self, history, context=None, *, out=None):
-        visible_bias, hidden_bias = self.dynamic_biases(history, context, out=out)
-        return CRBMFrames(
-            visible_bias, hidden_bias, self.visible_std, self.binary, self.weights
-        )
+    def bias_inputs(self, history, context):
+        """The inputs of the dynamic biases: ``(group, values)`` pairs.
 
-    def conditioner(self):
-        ops = self.ops
-        static = ops.concatenate((self.visible_bias, self.hidden_bias))
+        Each adds ``values @ group.T`` to ``[c_hat, b_hat]``, and its
+        statistic in :meth:`cd_statistics` is that of the group.  The
+        history (through ``dynamic``) and the context (through
+        ``context_weights``), those the layer has.
+        """
+        inputs = []
+        if self.n_lags:
+            inputs.append(("dynamic", history))
+        if self.n_context:
+            inputs.append(("context_weights", context))
+        return inputs
+
+    def frame_invariants(self):
         std = self.visible_std
-        input_weights = self.weights if std is None else self.weights / std
+        return {
+            "static": self.ops.concatenate((self.visible_bias, self.hidden_bias)),
+            "std": std,
+            "input_weights": self.weights if std is None else self.weights / std,
+        }
 
-        def frame_rbms(history, context=None):
-            visible_bias, hidden_bias = self.dynamic_biases(
-                history, context, static=static
-            )
-            return CRBMFrames(
-                visible_bias, hidden_bias, std, self.binary, self.weights, input_weights
-            )
-
-        return frame_rbms
+    def build_frame_rbms(self, invariants, history, context=None, *, out=None):
+        visible_bias, hidden_bias = self.dynamic_biases(
+            history, context, out=out, static=invariants["static"]
+        )
+        return CRBMFrames(
+            visible_bias,
+            hidden_bias,
+            invariants["std"],
+            self.visible_units,
+            self.weights,
+            invariants["input_weights"],
+            frame_invariant=self.n_lags == 0 and self.n_context == 0,
+        )
 
     # ------------------------------------------------------------ training
 
@@ -395,8 +435,8 @@ class CRBMLayer(ConditionalLayer):
         change of the visible mean (Montavon & Müller's centring, Cho, Raiko
         & Ilin's enhanced gradient).
 
-        The context weights' statistics are those of the directed weights
-        with the context in place of the history.
+        Every input of the dynamic biases (:meth:`bias_inputs`: the
+        history, the context) has the statistic ``delta.T @ input``.
         """
         n, d = visible.shape
         ops = self.ops
@@ -475,12 +515,10 @@ class CRBMLayer(ConditionalLayer):
         bias_sums = ops.dot(workspace.ones[:n], delta, out=workspace.bias_sums)
         out.visible_bias[...] = bias_sums[:d]
         out.hidden_bias[...] = bias_sums[d:]
-        if self.n_lags:
-            ops.matmul(delta.T, history, out=out.dynamic)
-            if workspace.dynamic_mask is not None:
-                out.dynamic *= workspace.dynamic_mask
-        if self.n_context:
-            out.context_weights[...] = ops.matmul(delta.T, context)
+        for name, values in self.bias_inputs(history, context):
+            ops.matmul(delta.T, values, out=getattr(out, name))
+        if workspace.dynamic_mask is not None:
+            out.dynamic *= workspace.dynamic_mask
         return out, squared_error
 
     def _centre_statistics(self, std, visible_bias, delta, d, scale, out):

@@ -179,11 +179,8 @@ class FactoredCRBM(BaseStyleModel):
     """
 
     _parameter_constraints: dict = {
-        **{
-            name: constraint
-            for name, constraint in BaseStyleModel._parameter_constraints.items()
-            if name != "hidden_order"
-        },
+        **BaseStyleModel._parameter_constraints,
+        "order": [Interval(Integral, 0, None, closed="left")],
         "n_components": [Interval(Integral, 1, None, closed="left")],
         "n_factors": [Interval(Integral, 1, None, closed="left")],
         "n_style_features": [Interval(Integral, 1, None, closed="left")],
@@ -274,10 +271,6 @@ class FactoredCRBM(BaseStyleModel):
         self.tol = tol
         self.random_state = random_state
         self.verbose = verbose
-
-    @property
-    def _hidden_order(self):
-        return self.order
 
     def _new_layer(self, n_features, n_context, dtype):
         return FactoredLayer(

@@ -25,7 +25,13 @@ import functools
 import numpy as np
 
 from ._gibbs import HiddenSampler
-from ._layer import ConditionalLayer, FrameRBMs, TrainingWorkspace
+from ._layer import (
+    GAUSSIAN,
+    VISIBLE_UNITS,
+    ConditionalLayer,
+    FrameRBMs,
+    TrainingWorkspace,
+)
 from ._parameters import ParameterGroup, small_normal
 from .utils._random import sample_bernoulli
 
@@ -125,7 +131,7 @@ class FactoredFrames(FrameRBMs):
     def __init__(
         self, visible_bias, hidden_bias, gates, visible_factors, hidden_factors
     ):
-        super().__init__(visible_bias, hidden_bias, None, False)
+        super().__init__(visible_bias, hidden_bias, None, VISIBLE_UNITS[GAUSSIAN])
         self.gates = gates
         self.visible_factors = visible_factors
         self.hidden_factors = hidden_factors
@@ -276,7 +282,7 @@ class FactoredLayer(ConditionalLayer):
             self.hidden_factors,
         )
 
-    def frame_rbms(self, history, context=None):
+    def build_frame_rbms(self, invariants, history, context=None, *, out=None):
         if context is None:
             raise ValueError("A factored layer needs every frame's context.")
         return self._rbms(self._terms(history, context))

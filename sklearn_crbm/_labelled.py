@@ -5,7 +5,7 @@ from numbers import Integral, Real
 from sklearn.utils._param_validation import Interval, StrOptions
 
 from ._base import FittedParameter
-from ._crbm_layer import CRBMLayer
+from ._crbm_layer import ORDER_CONSTRAINTS, CRBMLayer, hidden_order_of
 from ._style_model import BaseStyleModel
 
 __all__ = ["LabelledCRBM"]
@@ -115,6 +115,7 @@ class LabelledCRBM(BaseStyleModel):
 
     _parameter_constraints: dict = {
         **BaseStyleModel._parameter_constraints,
+        **ORDER_CONSTRAINTS,
         "n_components": [Interval(Integral, 1, None, closed="left")],
         "n_gibbs": [Interval(Integral, 0, None, closed="left")],
         "batching": [StrOptions({"balanced", "shuffled"})],
@@ -189,7 +190,7 @@ class LabelledCRBM(BaseStyleModel):
             n_features,
             self.n_components,
             self.order,
-            self._hidden_order,
+            hidden_order_of(self),
             "gaussian",
             dtype,
             n_context=n_context,

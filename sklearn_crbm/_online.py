@@ -262,7 +262,7 @@ class Offsets:
         self.sums = ops.zeros((n_chains, n_sequences, bottom.n_features), dtype)
         self.counts = ops.zeros((n_sequences, bottom.n_features), dtype)
         self.shrinkage = shrinkage
-        self.binary = bottom.binary
+        self.units = bottom.visible_units
 
     def update(self, prediction, frames, observed):
         """Add the residuals of ``frames`` (one per sequence) where ``observed``.
@@ -280,7 +280,7 @@ class Offsets:
         # a channel never observed has a zero sum; the floor spares 0 / 0
         denominator = ops.maximum(self.counts + self.shrinkage, 1)
         frames = frames + ops.where(missing, self.sums / denominator, 0)
-        return ops.clip(frames, 0, 1) if self.binary else frames
+        return self.units.clip(frames)
 
     def reorder(self, chains):
         """The chains' offsets follow their pasts (:meth:`History.reorder`)."""

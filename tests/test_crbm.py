@@ -553,7 +553,7 @@ def test_binary_visibles():
     hidden_bias = layer.hidden_bias + X[:-1] @ model.past_to_hidden_[0].T
     visible_bias = np.zeros((len(X) - 1, layer.n_features))  # unused by p(h | v)
     rbms = CRBMFrames(
-        visible_bias, hidden_bias, layer.visible_std, layer.binary, layer.weights
+        visible_bias, hidden_bias, layer.visible_std, layer.visible_units, layer.weights
     )
     H = rbms.hidden_probabilities(X[1:])
     assert_allclose(model.transform(X)[1:], H, rtol=1e-12)

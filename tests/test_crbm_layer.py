@@ -40,7 +40,9 @@ def frames_of(params, hidden_bias, visible_bias=None):
     """The frame RBMs of ``params`` with the given dynamic biases."""
     if visible_bias is None:
         visible_bias = np.zeros((len(hidden_bias), params.n_features), params.dtype)
-    return CRBMFrames(visible_bias, hidden_bias, None, False, params.weights)
+    return CRBMFrames(
+        visible_bias, hidden_bias, None, params.visible_units, params.weights
+    )
 
 
 def cd(params, visible, history, cd_steps, rng, *, out=None, scale=1.0, workspace=None):

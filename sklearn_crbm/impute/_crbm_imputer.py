@@ -7,7 +7,7 @@ from sklearn.base import _fit_context, clone
 from sklearn.frozen import FrozenEstimator
 from sklearn.utils import check_random_state, get_tags
 from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
-from sklearn.utils.validation import _num_samples, check_is_fitted
+from sklearn.utils.validation import _is_fitted, _num_samples, check_is_fitted
 
 from .._base import check_context, check_count
 from .._crbm import ConditionalRBM
@@ -50,11 +50,16 @@ class CRBMImputer(BaseMotionImputer):
 
     Parameters
     ----------
-    estimator : ConditionalRBM or StackedCRBM, default=None
-        The model, cloned and trained by :meth:`fit`; a fitted model wrapped
-        in :class:`sklearn.frozen.FrozenEstimator` is used as it is.  ``None``
-        means ``ConditionalRBM()`` seeded from ``random_state``.  The visible
-        units have unit variance: standardise the data first.
+    estimator : estimator of the package, default=None
+        The model (:class:`~sklearn_crbm.ConditionalRBM`,
+        :class:`~sklearn_crbm.StackedCRBM`, a style model, or any model of
+        conditional layers), cloned and trained by :meth:`fit`; a fitted
+        model wrapped in :class:`sklearn.frozen.FrozenEstimator` is used as
+        it is.  ``None`` means ``ConditionalRBM()`` seeded from
+        ``random_state``.  The imputer runs the model's layers
+        (``conditional_layers()``) given each frame's context
+        (``fill_in_context``).  The visible units have unit variance:
+        standardise the data first.
     n_gibbs : int, default=30
         Alternating Gibbs iterations per frame.
     n_draws : int, default=1
@@ -94,7 +99,7 @@ class CRBMImputer(BaseMotionImputer):
 
     Attributes
     ----------
-    estimator_ : ConditionalRBM or StackedCRBM
+    estimator_ : estimator of the package
         The fitted clone of ``estimator``, or the model inside a
         ``FrozenEstimator`` (not a copy).
     mean_ : ndarray of shape (`n_features_in_`,)
@@ -345,14 +350,19 @@ n_classes), default=None
     @property
     def _packed_parameters(self):
         """The model's parameter buffer: its namespace and device."""
-        return self.estimator_._packed_parameters
+        return self.estimator_.conditional_layers()[0].flat
+
+    def _matrix_product_size(self, n_features=None):
+        """The model's (:mod:`sklearn_crbm.utils._threads`)."""
+        if _is_fitted(self):
+            return self.estimator_._matrix_product_size(n_features)
+        model = ConditionalRBM() if self.estimator is None else self.estimator
+        return model._matrix_product_size(n_features)
 
     def _impute(self, X, sequence_ids, context, style, n_draws, random_state, average):
         X, mask, sequences = self._check_transform_input(X, sequence_ids)
         ops = array_ops(X)
-        model = self.estimator_
-        context = model._method_context(context, style, X.shape[0], X)
-        context = model._online_context(X, context)
+        context = self.estimator_.fill_in_context(X, context=context, style=style)
         if not bool(ops.any(mask)):
             return (
                 X if average else copy_array(ops.broadcast_to(X, (n_draws, *X.shape)))
@@ -410,7 +420,7 @@ n_classes), default=None
         ``(frame_context, hypotheses)``.  Returns an array of shape
         ``(n_draws, n_frames, n_features)`` in the model's dtype.
         """
-        layers = self.estimator_._layers()
+        layers = self.estimator_.conditional_layers()
         dtype, ops = layers[0].dtype, layers[0].ops
         X = ops.astype(X, dtype)
         frame_context, hypotheses = context
@@ -502,10 +512,10 @@ def _residual_variance(model, X, sequence_ids, styles, context):
     has one), given the frames' ``styles`` (a model of styles) or context.
     """
     ops = array_ops(X)
+    residuals = X - model.predict_next(
+        X, sequence_ids=sequence_ids, context=context, style=styles
+    )
     sequences = check_sequence_ids(sequence_ids, X.shape[0])
-    context = model._method_context(context, styles, X.shape[0], X)
-    context = model._online_context(X, context)[0]
-    residuals = X - model._predict_frames(X, sequences, context=context)
     rows = sequences.valid_frames(model.history_length)
     if len(rows):
         residuals = ops.take(residuals, rows, axis=0)
@@ -528,6 +538,8 @@ def _check_frozen(model, X):
             "imputer on data with the model's features (same preprocessing)."
         )
     check_same_place(
-        model._packed_parameters, X, f"The frozen {type(model).__name__} holds"
+        model.conditional_layers()[0].flat,
+        X,
+        f"The frozen {type(model).__name__} holds",
     )
     return model

@@ -228,10 +228,10 @@ class MotionPipeline(Pipeline):
         """Say in the raw channels' terms what a seed of the wrong shape lacks."""
         shape = np.shape(history) if history is not None else None
         model = self._final_estimator
-        width = max(model.history_length, 1)
         n_model = getattr(model, "n_features_in_", None)
         if shape is None or len(shape) not in (2, 3) or n_model is None:
             return  # the model's own checks say what is wrong
+        width = max(model.history_length, 1)
         n_raw = len(self.skeleton.feature_names)
         if shape[-1] == n_model and shape[-2] >= width:
             return

@@ -210,7 +210,11 @@ def _params(dtype, n_features=3, n_components=4):
 
 def _frame_rbms(params, visible_bias, hidden_bias):
     return CRBMFrames(
-        visible_bias, hidden_bias, params.visible_std, params.binary, params.weights
+        visible_bias,
+        hidden_bias,
+        params.visible_std,
+        params.visible_units,
+        params.weights,
     )
 
 
