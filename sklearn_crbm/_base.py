@@ -29,7 +29,6 @@ from sklearn.utils.validation import (
 )
 
 from ._gibbs import stacked_prediction
-from ._layer import sequence_frame_rbms, sequence_hidden_probabilities
 from ._likelihood import (
     LogLikelihood,
     frame_log_likelihood,
@@ -37,6 +36,7 @@ from ._likelihood import (
 )
 from ._online import TOP_LAYER, History, run_online
 from .exceptions import GenerationWarning
+from .layers._base import sequence_frame_rbms, sequence_hidden_probabilities
 from .metrics import motion_amplitude
 from .utils._array_api import array_ops, array_random, is_numpy, to_numpy
 from .utils._parallel import SAMPLE_BLOCK, map_sequence_blocks
@@ -86,7 +86,7 @@ class BaseCRBM(
     """Base class of the conditional RBMs: one layer or a stack of them.
 
     A fitted model is a stack of conditional layers
-    (:mod:`sklearn_crbm._layer`), bottom first (one for
+    (:mod:`sklearn_crbm.layers`), bottom first (one for
     :class:`ConditionalRBM`); the visible units of layer ``k + 1`` are the
     hidden units of layer ``k``.  This class holds everything that is the
     same for any such stack: input checks, :meth:`transform`,
@@ -135,7 +135,7 @@ class BaseCRBM(
 
     @abstractmethod
     def _layers(self):
-        """The fitted :class:`~sklearn_crbm._layer.ConditionalLayer` s, bottom first."""
+        """The fitted :class:`~sklearn_crbm.layers.ConditionalLayer` s, bottom first."""
 
     @abstractmethod
     def _planned_layers(self, n_features):
@@ -881,7 +881,7 @@ default=None
         -------
         layers : list of ConditionalLayer
             One for a one-layer model, one per layer for a stack (see
-            :mod:`sklearn_crbm._layer` for their interface).
+            :mod:`sklearn_crbm.layers` for their interface).
         """
         check_is_fitted(self)
         return list(self._layers())
@@ -929,7 +929,7 @@ class FittedParameter:
 
     ``components_ = FittedParameter("weights")`` on the class makes
     ``model.components_`` the ``weights`` view of ``model._layer`` (a
-    :class:`~sklearn_crbm._layer.ConditionalLayer`); an unfitted model
+    :class:`~sklearn_crbm.layers.ConditionalLayer`); an unfitted model
     has no such attribute.  Assigning to it writes into the view (same
     shape only), so the model computes with what was assigned.  A group that
     the parameters compute (``visible_variance``, from

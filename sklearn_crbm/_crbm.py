@@ -11,13 +11,13 @@ from sklearn.utils._param_validation import Interval, StrOptions
 
 from ._base import FittedParameter
 from ._base_layer import BaseLayerModel
-from ._crbm_layer import (
+from .layers._base import BINARY
+from .layers._crbm import (
     MIN_LOG_VARIANCE,
     ORDER_CONSTRAINTS,
     CRBMLayer,
     hidden_order_of,
 )
-from ._layer import BINARY
 from .utils._array_api import array_ops
 from .utils._autoregression import ridge_autoregression
 

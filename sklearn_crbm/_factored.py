@@ -5,8 +5,8 @@ from numbers import Integral, Real
 from sklearn.utils._param_validation import Interval
 
 from ._base import FittedParameter
-from ._factored_layer import FactoredLayer
 from ._style_model import BaseStyleModel
+from .layers._factored import FactoredLayer
 
 __all__ = ["FactoredCRBM"]
 

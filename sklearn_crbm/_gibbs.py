@@ -1,6 +1,6 @@
 """Gibbs sampling and mean-field prediction of frames, through one layer or a stack.
 
-Everything here works on :class:`~sklearn_crbm._layer.FrameRBMs`, a layer
+Everything here works on :class:`~sklearn_crbm.layers.FrameRBMs`, a layer
 given each frame's past and context, so it serves every kind of layer.  A
 stack is a list of frame RBMs, bottom first: layer ``k + 1``'s visible
 units are layer ``k``'s hidden units.

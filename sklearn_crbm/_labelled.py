@@ -5,8 +5,8 @@ from numbers import Integral, Real
 from sklearn.utils._param_validation import Interval, StrOptions
 
 from ._base import FittedParameter
-from ._crbm_layer import ORDER_CONSTRAINTS, CRBMLayer, hidden_order_of
 from ._style_model import BaseStyleModel
+from .layers._crbm import ORDER_CONSTRAINTS, CRBMLayer, hidden_order_of
 
 __all__ = ["LabelledCRBM"]
 

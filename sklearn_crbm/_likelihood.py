@@ -50,7 +50,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._layer import clipped_logit, draw_bernoulli, logistic
+from .layers._base import clipped_logit, draw_bernoulli, logistic
 from .utils._array_api import array_ops, copy_array
 
 # Hidden configurations summed per block by the exact enumeration.
@@ -492,7 +492,7 @@ def frame_log_likelihood(
     visible : ndarray of shape (n_frames, n_features)
         The frames, indexed by the rows of ``chunks``.
     chunks : iterable of (rows, FrameRBMs)
-        The frames' RBMs, as :func:`~sklearn_crbm._layer.sequence_frame_rbms`
+        The frames' RBMs, as :func:`~sklearn_crbm.layers.sequence_frame_rbms`
         yields them.  When every frame has the same RBM (``frame_invariant``:
         a layer without history or context), its one partition function is
         annealed once (:func:`shared_log_partition_ais`) with

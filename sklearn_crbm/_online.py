@@ -4,7 +4,7 @@ Every model's ``sample`` (:class:`~sklearn_crbm.ConditionalRBM`,
 :class:`~sklearn_crbm.StackedCRBM`, :class:`~sklearn_crbm.FactoredCRBM`,
 :class:`~sklearn_crbm.LabelledCRBM`) and
 :class:`~sklearn_crbm.impute.CRBMImputer` call :func:`run_online`, with
-one layer or a stack, of any kind (:mod:`sklearn_crbm._layer`):
+one layer or a stack, of any kind (:mod:`sklearn_crbm.layers`):
 
 - generation: nothing observed, every frame of every sequence drawn from a
   seed history;
@@ -31,7 +31,7 @@ from ._gibbs import (
     stacked_gibbs_frames,
     stacked_prediction,
 )
-from ._layer import sequence_hidden_probabilities
+from .layers._base import sequence_hidden_probabilities
 from .utils._array_api import array_ops, copy_array, to_numpy
 from .utils._sequences import Sequences
 

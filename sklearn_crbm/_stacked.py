@@ -4,13 +4,14 @@ from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import _fit_context, clone
-from sklearn.utils import check_random_state
+from sklearn.utils import check_random_state, get_tags
 from sklearn.utils._array_api import get_namespace
 from sklearn.utils._param_validation import HasMethods, Interval
 from sklearn.utils.validation import validate_data
 
 from ._base import BaseCRBM
 from ._crbm import ConditionalRBM
+from ._style_model import _on_host
 from .utils._array_api import array_ops
 from .utils._random import rng_from
 from .utils._sequences import check_sequence_ids
@@ -145,6 +146,9 @@ class StackedCRBM(BaseCRBM):
     >>> stack.sample(30, n_sequences=3, random_state=0).shape
     (90, 6)
     """
+
+    # A stack pickled before ``estimator`` existed stacks ConditionalRBMs.
+    estimator = None
 
     # The hyper-parameters every layer takes from the stack as they are.
     _layer_parameters = (
@@ -294,8 +298,9 @@ class StackedCRBM(BaseCRBM):
         ops = array_ops(hidden)
         if context is not None:
             context = ops.take(context, valid, axis=0)
-        if y is not None:
-            y = np.asarray(y)[valid]
+        # labels go up to layers that take them (a style model requires them)
+        takes_labels = y is not None and get_tags(layer).target_tags.required
+        y = _on_host(y)[valid] if takes_labels else None
         return ops.take(hidden, valid, axis=0), y, ids[valid], context
 
     # ------------------------------------------------------------------ fit

@@ -24,8 +24,8 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
 from sklearn_crbm import ConditionalRBM, TrainingDivergedError
-from sklearn_crbm._crbm_layer import CRBMFrames
 from sklearn_crbm.datasets import load_cmu35, make_oscillations
+from sklearn_crbm.layers._crbm import CRBMFrames
 from sklearn_crbm.model_selection import make_prediction_scorer
 from sklearn_crbm.utils._random import rng_from, standard_normal, uniform
 from sklearn_crbm.utils._sequences import balanced_batches, frame_history

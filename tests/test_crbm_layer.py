@@ -13,10 +13,10 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from scipy.special import expit
 
-from sklearn_crbm._crbm_layer import CRBMFrames, CRBMLayer
 from sklearn_crbm._gibbs import HiddenSampler, gibbs_frames
-from sklearn_crbm._layer import logistic
-from sklearn_crbm._parameters import MomentumUpdate
+from sklearn_crbm.layers._base import logistic
+from sklearn_crbm.layers._crbm import CRBMFrames, CRBMLayer
+from sklearn_crbm.layers._parameters import MomentumUpdate
 from sklearn_crbm.utils._random import uniform
 
 

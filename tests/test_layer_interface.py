@@ -27,16 +27,16 @@ from sklearn.frozen import FrozenEstimator
 from sklearn.utils._param_validation import Interval
 
 from sklearn_crbm._base_layer import BaseLayerModel
-from sklearn_crbm._layer import (
-    GAUSSIAN,
-    VISIBLE_UNITS,
-    ConditionalLayer,
-    FrameRBMs,
-)
-from sklearn_crbm._parameters import ParameterGroup, small_normal
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.exceptions import GenerationWarning
 from sklearn_crbm.impute import CRBMImputer
+from sklearn_crbm.layers import (
+    ConditionalLayer,
+    FrameRBMs,
+    GaussianUnits,
+    ParameterGroup,
+)
+from sklearn_crbm.layers._parameters import small_normal
 
 
 def _group(name, shape, decayed=True):
@@ -57,7 +57,7 @@ class ToyFrames(FrameRBMs):
     _shared_arrays = ("visible_std", "weights")
 
     def __init__(self, visible_bias, hidden_bias, weights):
-        super().__init__(visible_bias, hidden_bias, None, VISIBLE_UNITS[GAUSSIAN])
+        super().__init__(visible_bias, hidden_bias, None, GaussianUnits())
         self.weights = weights
 
     @property

@@ -15,14 +15,14 @@ from numpy.testing import assert_allclose
 from scipy.special import logsumexp
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_layer import CRBMFrames
-from sklearn_crbm._layer import GaussianUnits
 from sklearn_crbm._likelihood import (
     annealing_schedule,
     exact_is_cheaper,
     log_partition_ais,
     log_partition_exact,
 )
+from sklearn_crbm.layers._base import GaussianUnits
+from sklearn_crbm.layers._crbm import CRBMFrames
 
 
 def random_model(

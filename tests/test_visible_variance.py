@@ -18,9 +18,9 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.special import expit, logsumexp
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_layer import CRBMFrames, CRBMLayer
 from sklearn_crbm._gibbs import HiddenSampler
 from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.layers._crbm import CRBMFrames, CRBMLayer
 
 N_FEATURES, N_COMPONENTS, ORDER = 2, 3, 1
 HIDDEN = np.array(list(itertools.product([0, 1], repeat=N_COMPONENTS)), dtype=float)

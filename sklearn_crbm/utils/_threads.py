@@ -110,7 +110,7 @@ def limit_blas_threads(rows):
         product's size is that times the multiply-adds per row of the
         model's largest product, which the model's layers give
         (``estimator._matrix_product_size(n_features)``, from
-        :meth:`~sklearn_crbm._layer.ConditionalLayer.product_size`).  Errors
+        :meth:`~sklearn_crbm.layers.ConditionalLayer.product_size`).  Errors
         count as a small product: the method itself reports bad input.
 
     Returns

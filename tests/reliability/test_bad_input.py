@@ -2427,7 +2427,7 @@ CLI_CASES = {
 
 @pytest.mark.parametrize("name", list(CLI_CASES))
 def test_command_line_reports_bad_input_without_a_traceback(name, tmp_path, capsys):
-    from sklearn_crbm._cli import main
+    from sklearn_crbm.cli import main
 
     argv, message = CLI_CASES[name]
     status = main(argv(tmp_path))

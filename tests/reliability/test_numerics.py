@@ -8,10 +8,10 @@ import pytest
 import sklearn
 
 from sklearn_crbm import TrainingDivergedError
-from sklearn_crbm._crbm_layer import CRBMFrames, CRBMLayer
-from sklearn_crbm._layer import logistic
 from sklearn_crbm.datasets import load_cmu35, make_walker
 from sklearn_crbm.impute import CRBMImputer
+from sklearn_crbm.layers._base import logistic
+from sklearn_crbm.layers._crbm import CRBMFrames, CRBMLayer
 from sklearn_crbm.preprocessing import (
     ExpMapEncoder,
     RootRelativeEncoder,

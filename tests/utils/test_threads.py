@@ -92,7 +92,7 @@ def test_set_config_overrides_auto(two_threads):
 def test_estimators_limit_their_loops(two_threads, monkeypatch):
     X, ids = make_oscillations(n_sequences=3, n_frames=40, n_features=4, random_state=0)
     seen = []
-    from sklearn_crbm._crbm_layer import CRBMLayer
+    from sklearn_crbm.layers._crbm import CRBMLayer
 
     original = CRBMLayer.cd_statistics
 
@@ -159,7 +159,7 @@ def test_layer_product_size_is_its_largest_weight_matrix():
 
 def test_large_factored_model_trains_on_the_threads_allowed(two_threads, monkeypatch):
     """FactoredCRBM has no hidden_order: its work was once estimated as 0."""
-    from sklearn_crbm._factored_layer import FactoredLayer
+    from sklearn_crbm.layers._factored import FactoredLayer
 
     seen = []
     original = FactoredLayer.cd_statistics

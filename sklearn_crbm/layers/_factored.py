@@ -24,8 +24,9 @@ import functools
 
 import numpy as np
 
-from ._gibbs import HiddenSampler
-from ._layer import (
+from .._gibbs import HiddenSampler
+from ..utils._random import sample_bernoulli
+from ._base import (
     GAUSSIAN,
     VISIBLE_UNITS,
     ConditionalLayer,
@@ -33,7 +34,6 @@ from ._layer import (
     TrainingWorkspace,
 )
 from ._parameters import ParameterGroup, small_normal
-from .utils._random import sample_bernoulli
 
 __all__ = ["FactoredFrames", "FactoredLayer"]
 

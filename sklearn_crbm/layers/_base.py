@@ -12,7 +12,7 @@ interface, so a new kind of layer is one new class (and its estimator).
 
 The interface
 -------------
-A layer is a :class:`~sklearn_crbm._parameters.PackedParameters` (its
+A layer is a :class:`~sklearn_crbm.layers._parameters.PackedParameters` (its
 trainable arrays in one flat buffer) with
 
 ``n_features``, ``n_components``, ``n_lags``, ``n_context``, ``visible_type``
@@ -76,10 +76,10 @@ import math
 
 import numpy as np
 
+from ..utils._array_api import array_ops
+from ..utils._random import sample_bernoulli
+from ..utils._sequences import CHUNK_FRAMES, frame_history
 from ._parameters import PackedParameters
-from .utils._array_api import array_ops
-from .utils._random import sample_bernoulli
-from .utils._sequences import CHUNK_FRAMES, frame_history
 
 __all__ = [
     "BINARY",

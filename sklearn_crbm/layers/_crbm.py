@@ -32,10 +32,10 @@ from numbers import Integral
 import numpy as np
 from sklearn.utils._param_validation import Interval
 
-from ._gibbs import HiddenSampler
-from ._layer import ConditionalLayer, FrameRBMs, TrainingWorkspace
+from .._gibbs import HiddenSampler
+from ..utils._array_api import array_ops, same_memory
+from ._base import ConditionalLayer, FrameRBMs, TrainingWorkspace
 from ._parameters import ParameterGroup, small_normal
-from .utils._array_api import array_ops, same_memory
 
 __all__ = [
     "MIN_LOG_VARIANCE",
@@ -120,7 +120,7 @@ class CRBMFrames(FrameRBMs):
     Parameters
     ----------
     visible_bias, hidden_bias, visible_std, units, frame_invariant
-        As :class:`~sklearn_crbm._layer.FrameRBMs`.
+        As :class:`~sklearn_crbm.layers.FrameRBMs`.
     weights : ndarray of shape (n_components, n_features)
         ``W``.
     input_weights : ndarray of shape (n_components, n_features), default=None
