@@ -143,20 +143,12 @@ class BaseLayerModel(BaseCRBM):
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
         y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
-            The style of every frame, for the style models
-            (:class:`~sklearn_crbm.FactoredCRBM`,
-            :class:`~sklearn_crbm.LabelledCRBM`: a label per frame, or label
-            weights per frame), which turn it into their context; ignored by
-            :class:`~sklearn_crbm.ConditionalRBM`.
+            The style of every frame, as in :meth:`fit`.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
         context : array-like of shape (n_frames, n_context), default=None
-            Every frame's real-valued context (control signals such as
-            speed): :class:`~sklearn_crbm.ConditionalRBM` and
-            :class:`~sklearn_crbm.LabelledCRBM` add it to their dynamic
-            biases, :class:`~sklearn_crbm.FactoredCRBM` gates its factors
-            with it.  A model fitted with a context needs one in every
-            method that computes (``n_context_`` columns).  Not with ``y``.
+            Every frame's context, as in :meth:`fit` (of the width of the
+            first call's).
 
         Returns
         -------
