@@ -3,12 +3,23 @@
 A conditional layer models a frame ``v_t`` (visible units) with binary
 hidden units ``h``, given the frame's past ``x_{t-1}, ..., x_{t-L}`` (its
 *history*, ``L = n_lags`` frames flattened lag-major into one row) and,
-optionally, a per-frame *context* ``y_t`` (labels or other side
-information; a layer that has no use for it ignores it).  Given both, the
-layer is an RBM of the frame alone, with frame-specific parameters: a
-*frame RBM*.  Everything else in the package (training, generation and
-fill-in, the likelihood, the imputers) talks to layers only through this
+optionally, a per-frame *context* ``y_t`` (``n_context`` real values:
+control signals such as speed, or label weights).  Given both, the layer
+is an RBM of the frame alone, with frame-specific parameters: a *frame
+RBM*.  Everything else in the package (training, generation and fill-in,
+the likelihood, the imputers) talks to layers only through this
 interface, so a new kind of layer is one new class (and its estimator).
+
+The context reaches a layer from one keyword of every estimator method
+that depends on time (:class:`~sklearn_crbm._base.BaseCRBM`):
+``fit(X, y=None, *, sequence_ids=None, context=None)`` (and
+``partial_fit``, ``fit_transform``, ``score`` alike), ``transform``,
+``predict_next``, ``score_samples`` and ``estimate_log_likelihood`` with
+``(X, *, sequence_ids=None, context=None, style=None)``, and
+``sample(n_samples, *, history=None, context=None, style=None, ...)``;
+``context`` has shape ``(n_frames, n_context)`` (for ``sample``, one row
+per generated frame or one row for all), and the style models' labels
+(``y``, ``style=``) are turned into it.
 
 The interface
 -------------
