@@ -294,7 +294,7 @@ def style_folds(styles, trials, n_folds=3):
 # __init__ files, which only re-export): they are left out of the cache key,
 # so that changing them does not refit.
 _NOT_IN_A_FIT = set(
-    "datasets preprocessing impute metrics model_selection plotting _cli.py "
+    "datasets preprocessing impute metrics model_selection plotting cli "
     "__main__.py".split()
 )
 

@@ -214,10 +214,10 @@ def _n_parameters(model, names=CRBM_PARAMETERS):
     return sum(getattr(model, name).size for name in names if hasattr(model, name))
 
 
-def _estimate(model, Z, sequence_ids, seed, labels=()):
+def _estimate(model, Z, sequence_ids, seed, style=None):
     """Per frame ``(estimate, standard error, reverse estimate)``."""
     result = model.estimate_log_likelihood(
-        Z, *labels, sequence_ids=sequence_ids, reverse=True, random_state=seed
+        Z, sequence_ids=sequence_ids, style=style, reverse=True, random_state=seed
     )
     return result.log_likelihood, result.standard_error, result.lower
 
@@ -382,7 +382,7 @@ class StyleModel(Candidate):
         )
 
     def log_likelihood(self, Z, styles, sequence_ids, seed):
-        return _estimate(self.model, Z, sequence_ids, seed, labels=(styles,))
+        return _estimate(self.model, Z, sequence_ids, seed, style=styles)
 
     def recognise(self, Z, sequence_ids, styles, seed):
         named = self.model.set_params(random_state=seed).predict(

@@ -1,8 +1,8 @@
-"""``python -m sklearn_crbm``: see :mod:`sklearn_crbm._cli`."""
+"""``python -m sklearn_crbm``: see :mod:`sklearn_crbm.cli`."""
 
 import sys
 
-from ._cli import main
+from .cli import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -23,12 +23,12 @@ from sklearn.utils._array_api import check_same_namespace, get_namespace
 from sklearn.utils._param_validation import Interval, StrOptions
 from sklearn.utils.validation import (
     _check_sample_weight,
+    _is_fitted,
     check_is_fitted,
     validate_data,
 )
 
 from ._gibbs import stacked_prediction
-from ._layer import sequence_frame_rbms, sequence_hidden_probabilities
 from ._likelihood import (
     LogLikelihood,
     frame_log_likelihood,
@@ -36,6 +36,7 @@ from ._likelihood import (
 )
 from ._online import TOP_LAYER, History, run_online
 from .exceptions import GenerationWarning
+from .layers._base import sequence_frame_rbms, sequence_hidden_probabilities
 from .metrics import motion_amplitude
 from .utils._array_api import array_ops, array_random, is_numpy, to_numpy
 from .utils._parallel import SAMPLE_BLOCK, map_sequence_blocks
@@ -44,10 +45,18 @@ from .utils._random import rng_from
 from .utils._sequences import check_sequence_ids
 from .utils._threads import frame_rows, limit_blas_threads, sequence_rows
 
-__all__ = ["BaseCRBM", "check_count", "generated_liveliness", "seed_frames"]
+__all__ = [
+    "BaseCRBM",
+    "check_context",
+    "check_count",
+    "generated_liveliness",
+    "seed_frames",
+]
 
 # How many windows of training frames ``fit`` keeps to seed ``sample``.
 MAX_SEED_WINDOWS = 500
+# Gibbs iterations per generated frame of a model without an ``n_gibbs``.
+DEFAULT_N_GIBBS = 30
 # Mean-field iterations of the one-step-ahead prediction (``predict_next``).
 SCORE_MEAN_FIELD_STEPS = 10
 # Annealing of ``score`` for a model without ``ais_steps``/``ais_chains``.
@@ -77,20 +86,27 @@ class BaseCRBM(
     """Base class of the conditional RBMs: one layer or a stack of them.
 
     A fitted model is a stack of conditional layers
-    (:mod:`sklearn_crbm._layer`), bottom first (one for
+    (:mod:`sklearn_crbm.layers`), bottom first (one for
     :class:`ConditionalRBM`); the visible units of layer ``k + 1`` are the
     hidden units of layer ``k``.  This class holds everything that is the
     same for any such stack: input checks, :meth:`transform`,
-    :meth:`predict_next`, :meth:`score` and :meth:`score_samples`,
-    :meth:`sample` with its seed windows, and the constants.  Subclasses
-    fit, and provide the hooks :attr:`history_length`, ``_layers`` (every
-    fitted layer) and, where they differ from the defaults,
-    ``_ais_settings`` and ``_chain_rng``.
+    :meth:`predict_next`, :meth:`score`, :meth:`score_samples` and
+    :meth:`estimate_log_likelihood`, :meth:`sample` with its seed windows,
+    and the constants.  Subclasses fit, and provide the hooks
+    :attr:`history_length`, ``_layers`` (every fitted layer) and, where they
+    differ from the defaults, ``_ais_settings`` and ``_chain_rng``.
+
+    Every method that depends on time takes the same per-frame ``context``
+    (shape ``(n_frames, n_context)``, real-valued), which every layer gets
+    with the frame's past.  A model fitted with a context needs one
+    wherever it computes; the style models also take labels (``y`` in
+    :meth:`fit` and :meth:`score`, ``style`` elsewhere), which the hooks
+    ``_labels_context`` and ``_style_context`` turn into context, and infer
+    the context of frames given none (``_inference_context``,
+    ``_frame_log_likelihoods``).
     """
 
     _parameter_constraints: dict = {
-        "order": [Interval(Integral, 0, None, closed="left")],
-        "hidden_order": [None, Interval(Integral, 0, None, closed="left")],
         "learning_rate": [Interval(Real, 0, None, closed="neither")],
         "momentum": [Interval(Real, 0, 1, closed="left")],
         "momentum_delay": [Interval(Integral, 0, None, closed="left")],
@@ -108,75 +124,174 @@ class BaseCRBM(
     _start_jitter = START_JITTER
 
     # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
-    # search passes ``sequence_ids`` to these methods without being asked.
-    __metadata_request__fit = {"sequence_ids": True}
-    __metadata_request__partial_fit = {"sequence_ids": True}
-    __metadata_request__transform = {"sequence_ids": True}
-    __metadata_request__score = {"sequence_ids": True}
+    # search passes ``sequence_ids`` and ``context`` to these methods without
+    # being asked.
+    __metadata_request__fit = {"sequence_ids": True, "context": True}
+    __metadata_request__partial_fit = {"sequence_ids": True, "context": True}
+    __metadata_request__transform = {"sequence_ids": True, "context": True}
+    __metadata_request__score = {"sequence_ids": True, "context": True}
 
     # ---------------------------------------------------------------- hooks
 
-    @property
-    @abstractmethod
-    def history_length(self):
-        """Past frames a frame's top-layer representation depends on."""
-
     @abstractmethod
     def _layers(self):
-        """The fitted :class:`~sklearn_crbm._layer.ConditionalLayer` s, bottom first."""
+        """The fitted :class:`~sklearn_crbm.layers.ConditionalLayer` s, bottom first."""
+
+    @abstractmethod
+    def _planned_layers(self, n_features):
+        """The layers ``fit`` would make for ``n_features`` (not initialised)."""
+
+    @property
+    def history_length(self):
+        """Past frames a frame's top-layer representation depends on.
+
+        The sum of the layers' past frames (``max(order, hidden_order)``
+        each; before fit, those of the layers ``fit`` would make):
+        :meth:`sample` needs this many seed frames (at least one), and
+        :meth:`score` judges frames with this many past frames in their
+        sequence.
+        """
+        # the past a layer takes does not depend on its number of features
+        layers = self._layers() if _is_fitted(self) else self._planned_layers(1)
+        return sum(layer.n_lags for layer in layers)
+
+    def _matrix_product_size(self, n_features=None):
+        """Multiply-adds per frame of the largest matrix product of the layers.
+
+        Those fitted, or (``n_features`` given, before the first fit) those
+        ``fit`` would make; the package sizes its BLAS threads by it
+        (:mod:`sklearn_crbm.utils._threads`).
+        """
+        fitted = _is_fitted(self)
+        layers = self._layers() if fitted else self._planned_layers(n_features)
+        return max(layer.product_size() for layer in layers)
 
     def _ais_settings(self):
         """Intermediate distributions and chains per frame of the annealing."""
         return AIS_STEPS, AIS_CHAINS
 
-    def _online_context(self, X, style):
+    def _labels_context(self, y, X, reset):
+        """Every frame's context from the labels ``y`` (None: ``y`` is ignored)."""
+        return None
+
+    def _style_context(self, style, n_frames, like):
+        """Every frame's context from ``style`` (a model of styles only)."""
+        raise ValueError(
+            f"{type(self).__name__} has no styles: give context= instead of "
+            "style=, or use a style model such as FactoredCRBM or LabelledCRBM."
+        )
+
+    def _inference_context(self, X, sequences, context):
+        """The context of the frames of ``X``: the one given, which a model
+        fitted with a context needs (a style model infers it instead)."""
+        if context is None and self.n_context_:
+            raise self._missing_context_error()
+        return context
+
+    def _frame_log_likelihoods(self, X, sequences, context):
+        """Every frame's log-likelihood given its context (checked)."""
+        context = self._inference_context(X, sequences, context)
+        return self._log_likelihood(X, sequences, context=context).log_likelihood
+
+    def _online_context(self, X, context):
         """What on-line fill-in conditions on: ``(frame_context, hypotheses)``.
 
-        None and None for a model without context; a style model gives the
-        style of every frame of ``X``, or hypotheses for particles to weigh.
+        Every frame's context (None for a model without one); a style model
+        given none gives hypotheses for particles to weigh instead.
         """
-        if style is not None:
-            raise ValueError(
-                f"{type(self).__name__} has no styles: fill in without style=, or "
-                "with a style model such as FactoredCRBM."
-            )
-        return None, None
+        if context is None and self.n_context_:
+            raise self._missing_context_error()
+        return context, None
 
     def _chain_rng(self, rng):
         """The generator of ``sample``'s chains, given the one that picked seeds."""
         return rng
 
     @property
-    def _hidden_order(self):
-        return self.order if self.hidden_order is None else self.hidden_order
+    def n_context_(self):
+        """Columns of the per-frame ``context`` the model was fitted with (0: none)."""
+        check_is_fitted(self)
+        return self._layers()[0].n_context
 
-    @property
-    def _n_lags(self):
-        """Past frames of one layer: ``max(order, hidden_order)``."""
-        return max(self.order, self._hidden_order)
+    # ------------------------------------------------------------- context
+
+    def _fit_context(self, X, y, context, reset):
+        """Every frame's context in ``fit`` and ``score``: from ``y`` or ``context``."""
+        labels = self._labels_context(y, X, reset)
+        if labels is None:
+            if reset:
+                return check_context(context, X.shape[0], None, X)
+            if context is None and self.n_context_:
+                raise self._missing_context_error()
+            return check_context(context, X.shape[0], self.n_context_, X)
+        if context is not None:
+            raise self._both_error("y")
+        return labels
+
+    def _score_context(self, X, y, context):
+        """Every frame's context in ``score``, whose ``y`` only style models read."""
+        return check_context(context, X.shape[0], self.n_context_, X)
+
+    def _both_error(self, labels):
+        return ValueError(
+            f"{type(self).__name__} got both {labels} and context=: give the "
+            "labels (a style model turns them into its context) or a context, "
+            "not both."
+        )
+
+    def _method_context(self, context, style, n_frames, like, *, one_row=False):
+        """The context a method is given, as ``context`` or as ``style`` (checked).
+
+        With ``one_row`` (``sample``) a single row stands for every frame.
+        """
+        if style is not None:
+            if context is not None:
+                raise self._both_error("style=")
+            return self._style_context(style, n_frames, like)
+        return check_context(context, n_frames, self.n_context_, like, one_row=one_row)
+
+    def _missing_context_error(self):
+        k = self.n_context_
+        return ValueError(
+            f"{type(self).__name__} was fitted with a context of {k} column"
+            f"{'s' * (k != 1)} per frame, and computes nothing without one: pass "
+            f"context= of shape (n_frames, {k}) (for sample: (n_samples, {k}) "
+            f"or (1, {k})){self._context_hint}."
+        )
+
+    # how else a model can be told its context
+    _context_hint = ""
 
     # ------------------------------------------------------------------ fit
 
-    def fit_transform(self, X, y=None, *, sequence_ids=None):
+    def fit_transform(self, X, y=None, *, sequence_ids=None, context=None):
         """Fit, then return the top layer's hidden probabilities of ``X``.
 
         Parameters
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
+        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
+            The style of every frame, for the style models (see :meth:`fit`);
+            ignored by the others.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's real-valued context (see :meth:`fit`).
 
         Returns
         -------
         H : ndarray of shape (n_frames, n_components_out)
             Hidden probabilities, as :meth:`transform` gives them.
         """
-        return self.fit(X, sequence_ids=sequence_ids).transform(
-            X, sequence_ids=sequence_ids
-        )
+        self.fit(X, y, sequence_ids=sequence_ids, context=context)
+        return self._transform_training_data(X, y, sequence_ids, context)
+
+    @limit_blas_threads(frame_rows)
+    def _transform_training_data(self, X, y, sequence_ids, context):
+        X, sequences = self._check_inference_input(X, sequence_ids)
+        context = self._fit_context(X, y, context, reset=False)
+        return self._representations(X, sequences, self._layers(), context)[-1]
 
     def _keep_seeds(self, X, sequences, merge=False):
         """Keep windows of ``X`` to seed :meth:`sample`, and what it judges by.
@@ -243,6 +358,11 @@ class BaseCRBM(
         X = ops.astype(X, self._layers()[0].dtype, copy=False)
         return X, check_sequence_ids(sequence_ids, X.shape[0])
 
+    def _given_context(self, X, sequences, context, style):
+        """Every frame's context, from ``context`` or ``style``, else inferred."""
+        context = self._method_context(context, style, X.shape[0], X)
+        return self._inference_context(X, sequences, context)
+
     def _representations(self, X, sequences, layers, context=None):
         """The data, then ``layers``' hidden probabilities of it, bottom first."""
         representations = [X]
@@ -269,7 +389,7 @@ class BaseCRBM(
             yield per_layer[0][0], [rbms for _, rbms in per_layer]
 
     @limit_blas_threads(frame_rows)
-    def transform(self, X, *, sequence_ids=None):
+    def transform(self, X, *, sequence_ids=None, context=None, style=None):
         """Hidden probabilities of the top layer, frame by frame.
 
         Each layer's hidden probabilities ``p(h = 1 | x_t, history)`` are the
@@ -286,6 +406,15 @@ class BaseCRBM(
             All sequences stacked, each contiguous and in time order.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context, as in :meth:`fit`; needed by a model
+            fitted with one (a style model fitted on labels infers each
+            sequence's style instead: its posterior, :meth:`predict_proba`,
+            as label weights).
+        style : label or array-like of shape (n_frames,) or (n_frames, \
+n_classes), default=None
+            A style model's labels (one for every frame, one per frame, or
+            label weights per frame) in place of ``context``.
 
         Returns
         -------
@@ -293,10 +422,11 @@ class BaseCRBM(
             Hidden probabilities of the top layer, in the dtype of the model.
         """
         X, sequences = self._check_inference_input(X, sequence_ids)
-        return self._representations(X, sequences, self._layers())[-1]
+        context = self._given_context(X, sequences, context, style)
+        return self._representations(X, sequences, self._layers(), context)[-1]
 
     @limit_blas_threads(frame_rows)
-    def predict_next(self, X, *, sequence_ids=None):
+    def predict_next(self, X, *, sequence_ids=None, context=None, style=None):
         """One-step-ahead prediction of every frame from its history alone.
 
         A deterministic estimate of ``E[x_t | history]``: the top layer
@@ -315,6 +445,11 @@ class BaseCRBM(
             All sequences stacked, each contiguous and in time order.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context, as in :meth:`transform`.
+        style : label or array-like, default=None
+            A style model's labels in place of ``context``, as in
+            :meth:`transform`.
 
         Returns
         -------
@@ -322,7 +457,8 @@ class BaseCRBM(
             Predicted frames.
         """
         X, sequences = self._check_inference_input(X, sequence_ids, "predict_next")
-        return self._predict_frames(X, sequences)
+        context = self._given_context(X, sequences, context, style)
+        return self._predict_frames(X, sequences, context=context)
 
     def _predict_frames(self, X, sequences, frames=None, context=None):
         frames = np.arange(X.shape[0]) if frames is None else frames
@@ -336,7 +472,7 @@ class BaseCRBM(
         return predicted
 
     @limit_blas_threads(frame_rows)
-    def score_samples(self, X, *, sequence_ids=None):
+    def score_samples(self, X, *, sequence_ids=None, context=None, style=None):
         """Conditional log-likelihood ``log p(x_t | history)`` of every frame, in nats.
 
         One layer (:class:`ConditionalRBM`): exact when enumerating the
@@ -359,12 +495,22 @@ class BaseCRBM(
         Frames with fewer than :attr:`history_length` past frames in their
         sequence use edge padding, as :meth:`transform` does.
 
+        A style model fitted on labels and given neither ``context`` nor
+        ``style`` scores each frame under the mixture of the styles, each
+        weighted by its posterior given the sequence's frames before it
+        (from ``priors``): ``log sum_k p(k | x_<t) p(x_t | past, k)``.
+
         Parameters
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context, as in :meth:`transform`.
+        style : label or array-like, default=None
+            A style model's labels in place of ``context``, as in
+            :meth:`transform`.
 
         Returns
         -------
@@ -373,13 +519,9 @@ class BaseCRBM(
             each frame given its history, in the dtype of the model.
         """
         X, sequences = self._check_inference_input(X, sequence_ids, "score_samples")
-        log_likelihood = self._frame_log_likelihoods(X, sequences)
+        context = self._method_context(context, style, X.shape[0], X)
+        log_likelihood = self._frame_log_likelihoods(X, sequences, context)
         return array_ops(X).astype(log_likelihood, X.dtype)
-
-    def _frame_log_likelihoods(self, X, sequences, y=None):
-        """Every frame's log-likelihood, given ``y`` (ignored by a model without
-        context: it is what a search passes to ``score``)."""
-        return self._log_likelihood(X, sequences).log_likelihood
 
     def _log_likelihood(
         self, X, sequences, method="auto", reverse=False, rng=None, context=None
@@ -393,7 +535,6 @@ class BaseCRBM(
             return frame_log_likelihood(
                 X,
                 sequence_frame_rbms(layers[0], X, sequences, context=context),
-                shared=layers[0].n_lags == 0 and context is None,
                 method=method,
                 n_steps=n_steps,
                 n_chains=n_chains,
@@ -417,7 +558,89 @@ class BaseCRBM(
         return LogLikelihood(bound, None, ops.zeros_like(bound), "bound")
 
     @limit_blas_threads(frame_rows)
-    def score(self, X, y=None, *, sequence_ids=None, sample_weight=None):
+    def estimate_log_likelihood(
+        self,
+        X,
+        *,
+        sequence_ids=None,
+        context=None,
+        style=None,
+        method="auto",
+        reverse=True,
+        random_state=None,
+    ):
+        """``log p(x_t | history)`` of every frame, with how far to trust it.
+
+        Parameters
+        ----------
+        X : array-like of shape (n_frames, n_features)
+            All sequences stacked, each contiguous and in time order.
+        sequence_ids : array-like of shape (n_frames,), default=None
+            Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context, as in :meth:`transform`.
+        style : label or array-like, default=None
+            A style model's labels in place of ``context``, as in
+            :meth:`transform`.
+        method : {"auto", "exact", "ais"}, default="auto"
+            ``"exact"`` enumerates the hidden configurations (at most 24
+            hidden units), ``"ais"`` anneals (``ais_steps``,
+            ``ais_chains``), ``"auto"`` takes the cheaper.
+        reverse : bool, default=True
+            Also run reverse annealing (RAISE, Burda, Grosse & Salakhutdinov,
+            2015) from every frame: a conservative estimate, low on average,
+            that costs as much again.
+        random_state : int, RandomState instance or None, default=None
+            Seeds the annealing; ``None`` uses the estimator's
+            ``random_state`` (what :meth:`score` uses).
+
+        Returns
+        -------
+        result : :class:`~sklearn.utils.Bunch`
+            log_likelihood : ndarray of shape (n_frames,)
+                As :meth:`score_samples` gives it: forward AIS, high on
+                average (its partition function is low on average).
+            lower : ndarray of shape (n_frames,) or None
+                The reverse estimate (equal to ``log_likelihood`` when
+                exact; None if not ``reverse``, or for a stack, whose
+                estimate is a bound).  When the annealing is good the two
+                bracket the truth, and their gap bounds the error of either.
+            standard_error : ndarray of shape (n_frames,)
+                Standard error of the forward estimate across chains (0
+                when exact; for a model without history, that of its one
+                partition function).
+            method : str
+                ``"exact"``, ``"ais"`` or (a stack) ``"bound"``.
+
+        Examples
+        --------
+        >>> from sklearn_crbm import ConditionalRBM
+        >>> from sklearn_crbm.datasets import make_oscillations
+        >>> X, ids = make_oscillations(n_sequences=4, n_frames=40, random_state=0)
+        >>> model = ConditionalRBM(30, order=2, n_iter=20, random_state=0)
+        >>> model = model.fit(X, sequence_ids=ids)
+        >>> result = model.estimate_log_likelihood(X, sequence_ids=ids)
+        >>> result.method
+        'ais'
+        >>> print(f"{result.log_likelihood.mean():.2f} {result.lower.mean():.2f}")
+        -5.67 -5.67
+        """
+        X, sequences = self._check_inference_input(
+            X, sequence_ids, "estimate_log_likelihood"
+        )
+        context = self._given_context(X, sequences, context, style)
+        if method not in ("auto", "exact", "ais"):
+            raise ValueError(
+                f"method must be 'auto', 'exact' or 'ais', got {method!r}."
+            )
+        rng = rng_from(self.random_state if random_state is None else random_state)
+        result = self._log_likelihood(
+            X, sequences, method=method, reverse=reverse, rng=rng, context=context
+        )
+        return Bunch(**result._asdict())
+
+    @limit_blas_threads(frame_rows)
+    def score(self, X, y=None, *, sequence_ids=None, context=None, sample_weight=None):
         """Mean held-out log-likelihood per frame, in nats; higher is better.
 
         The mean of :meth:`score_samples` over every frame with
@@ -435,10 +658,13 @@ class BaseCRBM(
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
+        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
+            A style model's labels of every frame (None: unknown, see
+            :meth:`score_samples`); ignored by the other models.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context, as in :meth:`fit`.
         sample_weight : array-like of shape (n_frames,), default=None
             Weight of each frame in the mean; frames without a full history
             are left out whatever their weight.
@@ -457,8 +683,9 @@ class BaseCRBM(
                 "sequences."
             )
         ops = array_ops(X)
+        context = self._score_context(X, y, context)
         # every frame, as score_samples draws them: the same random numbers
-        log_likelihood = self._frame_log_likelihoods(X, sequences, y)
+        log_likelihood = self._frame_log_likelihoods(X, sequences, context)
         log_likelihood = ops.take(log_likelihood, frames, axis=0)
         if sample_weight is None:
             return float(ops.mean(log_likelihood))
@@ -473,8 +700,10 @@ class BaseCRBM(
         n_samples,
         *,
         history=None,
+        context=None,
+        style=None,
         n_sequences=1,
-        n_gibbs=30,
+        n_gibbs=None,
         hidden_noise=0.0,
         sample_visibles=False,
         random_state=None,
@@ -502,11 +731,22 @@ class BaseCRBM(
             sequence alike; shape ``(n_sequences, n_frames, n_features)``
             gives each sequence its own seed.  ``None`` draws windows of real
             training frames kept by :meth:`fit` (``seed_windows_``).
+        context : array-like of shape (n_samples, n_context) or (1, n_context), \
+default=None
+            The context of every new frame (one row: the same for all),
+            for every sequence; needed by a model fitted with a context.
+            Changing it over the frames steers the motion (a transition).
+        style : label or array-like of shape (n_samples, n_classes), default=None
+            A style model's labels in place of ``context``: a label seen in
+            :meth:`fit`, or non-negative label weights that sum to 1 in
+            every frame (a blend; a transition when they change over the
+            frames).
         n_sequences : int, default=1
             Number of sequences to generate; with a 3-D ``history`` it is
             taken from the history.
-        n_gibbs : int, default=30
-            Alternating Gibbs iterations per frame.
+        n_gibbs : int, default=None
+            Alternating Gibbs iterations per frame; None: the model's
+            ``n_gibbs`` parameter if it has one, else 30.
         hidden_noise : float, default=0.0
             Standard deviation of Gaussian noise added to the (top layer's)
             hidden biases each time hidden states are chosen (paper §4.3:
@@ -540,12 +780,18 @@ class BaseCRBM(
         """
         check_is_fitted(self)
         n_samples = check_count(n_samples, "n_samples", minimum=1)
+        if n_gibbs is None:
+            n_gibbs = self.get_params().get("n_gibbs", DEFAULT_N_GIBBS)
         n_gibbs = check_count(n_gibbs, "n_gibbs", minimum=0)
         n_sequences = check_count(n_sequences, "n_sequences", minimum=1)
         if not isinstance(hidden_noise, Real) or not hidden_noise >= 0:
             raise ValueError(
                 f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
             )
+        like = self.seed_windows_
+        context = self._method_context(context, style, n_samples, like, one_row=True)
+        if context is None and self.n_context_:
+            raise self._missing_context_error()
         rng = rng_from(self.random_state if random_state is None else random_state)
         seed = seed_frames(
             history,
@@ -556,10 +802,15 @@ class BaseCRBM(
             seed_windows=self.seed_windows_,
             rng=rng,
         )
+        if context is not None:
+            context = array_ops(seed).broadcast_to(
+                context[None, ...], (seed.shape[0], *context.shape)
+            )
         frames = self._generate(
             seed,
             n_samples,
             rng,
+            context=context,
             n_gibbs=n_gibbs,
             hidden_noise=hidden_noise,
             sample_visibles=sample_visibles,
@@ -621,6 +872,46 @@ class BaseCRBM(
         )
         return ops.reshape(ops.concatenate(blocks), (-1, self.n_features_in_))
 
+    # ------------------------------------------------------ on-line fill-in
+
+    def conditional_layers(self):
+        """The fitted conditional layers, bottom first: what on-line fill-in runs.
+
+        Returns
+        -------
+        layers : list of ConditionalLayer
+            One for a one-layer model, one per layer for a stack (see
+            :mod:`sklearn_crbm.layers` for their interface).
+        """
+        check_is_fitted(self)
+        return list(self._layers())
+
+    def fill_in_context(self, X, *, context=None, style=None):
+        """What on-line fill-in of the frames ``X`` conditions on.
+
+        Parameters
+        ----------
+        X : ndarray of shape (n_frames, n_features)
+            The frames, checked, in the namespace of the model.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context, as in :meth:`transform`.
+        style : label or array-like, default=None
+            A style model's labels in place of ``context``.
+
+        Returns
+        -------
+        frame_context : ndarray of shape (n_frames, n_context) or None
+            Every frame's context, given (or from ``style``); None for a
+            model without one, or where it is to be inferred.
+        hypotheses : ndarray of shape (n_hypotheses, n_context) or None
+            With ``frame_context`` None, the contexts that the particles of
+            a filter carry and resampling weighs (a style model fitted on
+            labels: one per style); else None.
+        """
+        check_is_fitted(self)
+        context = self._method_context(context, style, X.shape[0], X)
+        return self._online_context(X, context)
+
     # ---------------------------------------------------------------- misc
 
     @property
@@ -638,7 +929,7 @@ class FittedParameter:
 
     ``components_ = FittedParameter("weights")`` on the class makes
     ``model.components_`` the ``weights`` view of ``model._layer`` (a
-    :class:`~sklearn_crbm._layer.ConditionalLayer`); an unfitted model
+    :class:`~sklearn_crbm.layers.ConditionalLayer`); an unfitted model
     has no such attribute.  Assigning to it writes into the view (same
     shape only), so the model computes with what was assigned.  A group that
     the parameters compute (``visible_variance``, from
@@ -719,6 +1010,62 @@ def seed_frames(history, n_sequences, *, width, n_features, dtype, seed_windows,
     if not ops.all(ops.isfinite(history)):
         raise ValueError("history contains NaN or infinity.")
     return ops.ascontiguousarray(history[:, -width:, ...])
+
+
+def check_context(context, n_frames, n_context, like, *, one_row=False):
+    """``context`` as an array of ``like``'s namespace, dtype and device.
+
+    Parameters
+    ----------
+    context : array-like of shape (n_frames, n_context) or None
+        None passes through.
+    n_frames : int
+    n_context : int or None
+        The columns a fitted model takes (0: none); None in ``fit``, where
+        any number of columns but 0 is one.
+    like : ndarray
+    one_row : bool, default=False
+        Whether one row may stand for every frame (then broadcast).
+
+    Returns
+    -------
+    context : ndarray of shape (n_frames, n_context) or None
+    """
+    if context is None:
+        return None
+    if n_context == 0:
+        raise ValueError(
+            "This model was fitted without context, so it takes none: fit it "
+            "with context= of shape (n_frames, n_context) to condition on one."
+        )
+    if hasattr(context, "toarray") or hasattr(context, "tocsr"):
+        raise TypeError("context must be a dense array, got a sparse matrix.")
+    ops = array_ops(like)
+    try:
+        context = ops.asarray(context, dtype=like.dtype)
+    except (TypeError, ValueError) as exc:
+        raise TypeError(
+            f"context must be an array of numbers, got {type(context).__name__}."
+        ) from exc
+    rows = (1, n_frames) if one_row else (n_frames,)
+    wanted = "(n_frames, n_context)" if n_context is None else f"(n, {n_context})"
+    if (
+        context.ndim != 2
+        or context.shape[0] not in rows
+        or context.shape[1] == 0
+        or n_context not in (None, context.shape[1])
+    ):
+        frames = " or ".join(str(n) for n in rows)
+        raise ValueError(
+            f"context must have shape {wanted} with n = {frames}: one row of "
+            f"context per frame; got shape {tuple(context.shape)}. A single "
+            "signal is one column: context.reshape(-1, 1)."
+        )
+    if not bool(ops.all(ops.isfinite(context))):
+        raise ValueError("context contains NaN or infinity.")
+    if context.shape[0] != n_frames:
+        context = ops.broadcast_to(context, (n_frames, context.shape[1]))
+    return context
 
 
 def generation_statistics(X, sequences):

@@ -12,7 +12,7 @@ from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import _fit_context
-from sklearn.utils import Bunch, check_random_state
+from sklearn.utils import check_random_state
 from sklearn.utils._array_api import get_namespace_and_device, move_to
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import validate_data
@@ -46,9 +46,8 @@ class BaseLayerModel(BaseCRBM):
     held-out sequences if asked), keeping windows of real frames to seed
     :meth:`sample`.  Subclasses provide the hooks ``_new_layer`` (the layer,
     not yet initialised) and, where they need them, ``_check_training_data``
-    (checks of the data against the parameters), ``_start_parameters`` (a
-    start other than the random one) and ``_labels_context`` (the per-frame
-    context of a layer that takes one, from ``y``).
+    (checks of the data against the parameters) and ``_start_parameters``
+    (a start other than the random one).
     """
 
     _parameter_constraints: dict = {
@@ -71,8 +70,9 @@ class BaseLayerModel(BaseCRBM):
     # ---------------------------------------------------------------- hooks
 
     @abstractmethod
-    def _new_layer(self, n_features, dtype):
-        """The model's layer for ``n_features`` visible units, not initialised."""
+    def _new_layer(self, n_features, n_context, dtype):
+        """The model's layer for ``n_features`` visible units and ``n_context``
+        columns of context, not initialised."""
 
     def _check_training_data(self, X):
         """Raise a ValueError if the parameters cannot model ``X``."""
@@ -80,15 +80,11 @@ class BaseLayerModel(BaseCRBM):
     def _start_parameters(self, X, frames, context):
         """Change the random start of the layer where the parameters ask for it."""
 
-    def _labels_context(self, y, X, reset):
-        """Every frame's context from ``fit``'s ``y`` (None: the layer takes none)."""
-        return None
-
     # ------------------------------------------------------------------ fit
 
     @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y=None, *, sequence_ids=None):
+    def fit(self, X, y=None, *, sequence_ids=None, context=None):
         """Train the model on sequences of frames.
 
         Parameters
@@ -96,12 +92,20 @@ class BaseLayerModel(BaseCRBM):
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
         y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
-            The style of every frame, for the models that take one (required
-            by :class:`~sklearn_crbm.FactoredCRBM` and
+            The style of every frame, for the style models
+            (:class:`~sklearn_crbm.FactoredCRBM`,
             :class:`~sklearn_crbm.LabelledCRBM`: a label per frame, or label
-            weights per frame); ignored by :class:`~sklearn_crbm.ConditionalRBM`.
+            weights per frame), which turn it into their context; ignored by
+            :class:`~sklearn_crbm.ConditionalRBM`.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's real-valued context (control signals such as
+            speed): :class:`~sklearn_crbm.ConditionalRBM` and
+            :class:`~sklearn_crbm.LabelledCRBM` add it to their dynamic
+            biases, :class:`~sklearn_crbm.FactoredCRBM` gates its factors
+            with it.  A model fitted with a context needs one in every
+            method that computes (``n_context_`` columns).  Not with ``y``.
 
         Returns
         -------
@@ -113,9 +117,9 @@ class BaseLayerModel(BaseCRBM):
             xp, _ = get_namespace_and_device(X)[:2]
             X = validate_data(self, X, dtype=[xp.float64, xp.float32], reset=True)
             sequences, frames = self._check_sequences(X, sequence_ids)
-            context = self._labels_context(y, X, reset=True)
+            context = self._fit_context(X, y, context, reset=True)
             self.random_state_ = check_random_state(self.random_state)
-            self._initialize(X)
+            self._initialize(X, context)
             if self.early_stopping:
                 self._train_with_early_stopping(X, sequences, context)
             else:
@@ -128,7 +132,7 @@ class BaseLayerModel(BaseCRBM):
 
     @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
-    def partial_fit(self, X, y=None, *, sequence_ids=None):
+    def partial_fit(self, X, y=None, *, sequence_ids=None, context=None):
         """Train for one epoch on the given sequences, keeping the current state.
 
         The first call initialises the model; later calls continue from the
@@ -139,12 +143,12 @@ class BaseLayerModel(BaseCRBM):
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
         y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
-            The style of every frame, for the models that take one (required
-            by :class:`~sklearn_crbm.FactoredCRBM` and
-            :class:`~sklearn_crbm.LabelledCRBM`: a label per frame, or label
-            weights per frame); ignored by :class:`~sklearn_crbm.ConditionalRBM`.
+            The style of every frame, as in :meth:`fit`.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context, as in :meth:`fit` (of the width of the
+            first call's).
 
         Returns
         -------
@@ -164,28 +168,21 @@ class BaseLayerModel(BaseCRBM):
                 reset=first_call,
             )
             sequences, frames = self._check_sequences(X, sequence_ids)
-            context = self._labels_context(y, X, reset=first_call)
+            context = self._fit_context(X, y, context, reset=first_call)
         with unfitted_on_error(self):
             if first_call:
                 self.random_state_ = check_random_state(self.random_state)
-                self._initialize(X)
+                self._initialize(X, context)
                 self._start_parameters(X, frames, context)
             self._train(X, frames, 1, context=context)
         self._keep_seeds(X, sequences, merge=True)
         return self
 
-    @property
-    def history_length(self):
-        """Past frames a frame depends on: ``max(order, hidden_order)``.
-
-        :meth:`sample` needs this many seed frames (at least one), and
-        :meth:`score` judges frames with this many past frames in their
-        sequence.
-        """
-        return self._n_lags
-
     def _layers(self):
         return [self._layer]
+
+    def _planned_layers(self, n_features):
+        return [self._new_layer(n_features, 0, np.float64)]
 
     def _n_epochs(self, n_frames):
         """The epochs ``fit`` trains on ``n_frames`` trainable frames.
@@ -206,19 +203,20 @@ class BaseLayerModel(BaseCRBM):
         """Validate ids and data; return the sequences and trainable frames."""
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
         self._check_training_data(X)
-        frames = sequences.valid_frames(self._n_lags)
+        n_lags = self._planned_layers(X.shape[1])[0].n_lags
+        frames = sequences.valid_frames(n_lags)
         if len(frames) == 0:
             longest = int(sequences.lengths.max()) if len(sequences.lengths) else 0
             noun = "sample" if longest == 1 else "samples"
             raise ValueError(
-                f"No frame has {self._n_lags} past frames in its own sequence: the "
+                f"No frame has {n_lags} past frames in its own sequence: the "
                 f"longest sequence has {longest} {noun}, but a model of order "
-                f"{self._n_lags} needs sequences of at least {self._n_lags + 1} "
+                f"{n_lags} needs sequences of at least {n_lags + 1} "
                 "frames. Pass longer sequences (check sequence_ids) or lower order."
             )
         return sequences, frames
 
-    def _initialize(self, X):
+    def _initialize(self, X, context):
         """Draw the start parameters, in the namespace and on the device of ``X``.
 
         They are drawn with numpy (the same numbers for every namespace) and
@@ -226,7 +224,8 @@ class BaseLayerModel(BaseCRBM):
         """
         ops = array_ops(X)
         dtype = np.float32 if X.dtype == ops.float32 else np.float64
-        layer = self._new_layer(X.shape[1], dtype)
+        n_context = 0 if context is None else context.shape[1]
+        layer = self._new_layer(X.shape[1], n_context, dtype)
         layer.initialize(rng_from(self.random_state_))
         if ops is not np:
             xp, _, device = get_namespace_and_device(X)
@@ -266,12 +265,12 @@ class BaseLayerModel(BaseCRBM):
         parts = []
         for mask in (~held, held):
             part = check_sequence_ids(ids[mask], int(mask.sum()))
-            frames = part.valid_frames(self._n_lags)
+            frames = part.valid_frames(self.history_length)
             if len(frames) == 0:
                 raise ValueError(
                     f"early_stopping: no {'validation' if mask is held else 'training'}"
-                    f" frame has {self._n_lags} past frames in its sequence; pass "
-                    "longer sequences or raise validation_fraction."
+                    f" frame has {self.history_length} past frames in its sequence; "
+                    "pass longer sequences or raise validation_fraction."
                 )
             rows = np.flatnonzero(mask)
             part_context = None if context is None else ops.take(context, rows, axis=0)
@@ -305,18 +304,6 @@ class BaseLayerModel(BaseCRBM):
                 break
         self._layer = best_layer
         self.best_validation_score_ = best
-
-    def _estimate(self, X, sequences, context, method, reverse, random_state):
-        """``estimate_log_likelihood`` of checked input, given every frame's context."""
-        if method not in ("auto", "exact", "ais"):
-            raise ValueError(
-                f"method must be 'auto', 'exact' or 'ais', got {method!r}."
-            )
-        rng = rng_from(self.random_state if random_state is None else random_state)
-        result = self._log_likelihood(
-            X, sequences, method=method, reverse=reverse, rng=rng, context=context
-        )
-        return Bunch(**result._asdict())
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()

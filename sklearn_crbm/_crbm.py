@@ -11,11 +11,15 @@ from sklearn.utils._param_validation import Interval, StrOptions
 
 from ._base import FittedParameter
 from ._base_layer import BaseLayerModel
-from ._crbm_layer import MIN_LOG_VARIANCE, CRBMLayer
-from ._layer import BINARY
+from .layers._base import BINARY
+from .layers._crbm import (
+    MIN_LOG_VARIANCE,
+    ORDER_CONSTRAINTS,
+    CRBMLayer,
+    hidden_order_of,
+)
 from .utils._array_api import array_ops
 from .utils._autoregression import ridge_autoregression
-from .utils._threads import frame_rows, limit_blas_threads
 
 # Ridge penalty of init="autoregressive": AutoregressiveImputer's default.
 _AUTOREGRESSIVE_ALPHA = 1.0
@@ -26,8 +30,10 @@ class ConditionalRBM(BaseLayerModel):
 
     Models each frame with Gaussian or binary visible units and binary hidden
     units, conditioned on the previous frames of its sequence through
-    autoregressive and past-to-hidden weights (Taylor, Hinton & Roweis, 2006).
-    ``X`` stacks all sequences; ``sequence_ids`` marks the frames of each.
+    autoregressive and past-to-hidden weights (Taylor, Hinton & Roweis, 2006)
+    and, if given, on a real-valued per-frame ``context`` (control signals
+    such as speed), which adds to the same dynamic biases.  ``X`` stacks all
+    sequences; ``sequence_ids`` marks the frames of each.
 
     Read more in the :ref:`User Guide <training>`.
 
@@ -118,6 +124,12 @@ class ConditionalRBM(BaseLayerModel):
         ``past_to_hidden_[q - 1] @ x[t - q]`` adds to frame ``t``'s hidden input.
     visible_variance_ : ndarray of shape (n_features,)
         Variance of each Gaussian visible unit (ones for ``"unit"``).
+    context_to_visible_ : ndarray of shape (n_features, n_context)
+        ``context_to_visible_ @ y_t`` adds to frame ``t``'s visible mean.
+    context_to_hidden_ : ndarray of shape (n_components, n_context)
+        ``context_to_hidden_ @ y_t`` adds to frame ``t``'s hidden input.
+    n_context_ : int
+        Columns of the context the model was fitted with (0: none).
     seed_windows_ : ndarray of shape (n_windows, width, n_features)
         Windows of consecutive training frames that seed :meth:`sample`.
     reconstruction_error_ : float
@@ -159,6 +171,7 @@ class ConditionalRBM(BaseLayerModel):
 
     _parameter_constraints: dict = {
         **BaseLayerModel._parameter_constraints,
+        **ORDER_CONSTRAINTS,
         "n_components": [Interval(Integral, 1, None, closed="left")],
         "visible_type": [StrOptions({"gaussian", "binary"})],
         "visible_variance": [StrOptions({"unit", "learned", "residual"})],
@@ -172,6 +185,8 @@ class ConditionalRBM(BaseLayerModel):
     autoregressive_ = FittedParameter("autoregressive")
     past_to_hidden_ = FittedParameter("past_to_hidden")
     visible_variance_ = FittedParameter("visible_variance")
+    context_to_visible_ = FittedParameter("context_to_visible")
+    context_to_hidden_ = FittedParameter("context_to_hidden")
 
     def __init__(
         self,
@@ -286,14 +301,15 @@ class ConditionalRBM(BaseLayerModel):
 
     # ------------------------------------------------------------ hooks
 
-    def _new_layer(self, n_features, dtype):
+    def _new_layer(self, n_features, n_context, dtype):
         return CRBMLayer(
             n_features,
             self.n_components,
             self.order,
-            self._hidden_order,
+            hidden_order_of(self),
             self.visible_type,
             dtype,
+            n_context=n_context,
             learned_variance=self.visible_variance == "learned",
             fixed_variance=self.visible_variance == "residual",
             centered=self.centering,
@@ -312,10 +328,10 @@ class ConditionalRBM(BaseLayerModel):
                 "visible mean and needs Gaussian visibles. Use centering=False "
                 "with binary visibles."
             )
-        if self.centering and self._hidden_order < self.order:
+        if self.centering and hidden_order_of(self) < self.order:
             raise ValueError(
                 f"centering=True needs hidden_order >= order (got hidden_order="
-                f"{self._hidden_order}, order={self.order}): the centred hidden "
+                f"{hidden_order_of(self)}, order={self.order}): the centred hidden "
                 "input is written back through the past-to-hidden weights of every "
                 "autoregressive lag. Raise hidden_order or use centering=False."
             )
@@ -358,63 +374,3 @@ class ConditionalRBM(BaseLayerModel):
             self.visible_variance_ = np.maximum(
                 variance, np.exp(MIN_LOG_VARIANCE)
             ).astype(X.dtype)
-
-    @limit_blas_threads(frame_rows)
-    def estimate_log_likelihood(
-        self, X, *, sequence_ids=None, method="auto", reverse=True, random_state=None
-    ):
-        """``log p(x_t | history)`` of every frame, with how far to trust it.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-        method : {"auto", "exact", "ais"}, default="auto"
-            ``"exact"`` enumerates the hidden configurations (at most 24
-            hidden units), ``"ais"`` anneals (``ais_steps``,
-            ``ais_chains``), ``"auto"`` takes the cheaper.
-        reverse : bool, default=True
-            Also run reverse annealing (RAISE, Burda, Grosse & Salakhutdinov,
-            2015) from every frame: a conservative estimate, low on average,
-            that costs as much again.
-        random_state : int, RandomState instance or None, default=None
-            Seeds the annealing; ``None`` uses the estimator's
-            ``random_state`` (what :meth:`score` uses).
-
-        Returns
-        -------
-        result : :class:`~sklearn.utils.Bunch`
-            log_likelihood : ndarray of shape (n_frames,)
-                As :meth:`score_samples` gives it: forward AIS, high on
-                average (its partition function is low on average).
-            lower : ndarray of shape (n_frames,) or None
-                The reverse estimate (equal to ``log_likelihood`` when
-                exact; None if not ``reverse``).  When the annealing is
-                good the two bracket the truth, and their gap bounds the
-                error of either.
-            standard_error : ndarray of shape (n_frames,)
-                Standard error of the forward estimate across chains (0
-                when exact; for a model without history, that of its one
-                partition function).
-            method : str
-                ``"exact"`` or ``"ais"``.
-
-        Examples
-        --------
-        >>> from sklearn_crbm import ConditionalRBM
-        >>> from sklearn_crbm.datasets import make_oscillations
-        >>> X, ids = make_oscillations(n_sequences=4, n_frames=40, random_state=0)
-        >>> model = ConditionalRBM(30, order=2, n_iter=20, random_state=0)
-        >>> model = model.fit(X, sequence_ids=ids)
-        >>> result = model.estimate_log_likelihood(X, sequence_ids=ids)
-        >>> result.method
-        'ais'
-        >>> print(f"{result.log_likelihood.mean():.2f} {result.lower.mean():.2f}")
-        -5.67 -5.67
-        """
-        X, sequences = self._check_inference_input(
-            X, sequence_ids, "estimate_log_likelihood"
-        )
-        return self._estimate(X, sequences, None, method, reverse, random_state)

@@ -5,8 +5,8 @@ from numbers import Integral, Real
 from sklearn.utils._param_validation import Interval
 
 from ._base import FittedParameter
-from ._factored_layer import FactoredLayer
 from ._style_model import BaseStyleModel
+from .layers._factored import FactoredLayer
 
 __all__ = ["FactoredCRBM"]
 
@@ -15,8 +15,10 @@ class FactoredCRBM(BaseStyleModel):
     """Factored conditional RBM whose interactions are gated by style labels.
 
     One model of motion in many styles (Taylor & Hinton, 2009).  Each
-    frame's label weights ``y`` (one-hot for a labelled frame) give style
-    features ``z = y R``, and every interaction of a conditional RBM (past
+    frame's label weights ``y`` (one-hot for a labelled frame), or its
+    real-valued ``context`` (control signals such as speed; Taylor, Hinton
+    & Roweis, 2011), give style features ``z = y R``, and every
+    interaction of a conditional RBM (past
     to visible, past to hidden, visible to hidden) goes through factors
     that the style features gate, so that one set of weights learns what
     the styles share and the gates what sets them apart.  Given its labels
@@ -110,7 +112,11 @@ class FactoredCRBM(BaseStyleModel):
     Attributes
     ----------
     classes_ : ndarray of shape (n_classes,)
-        The styles, in the order of the columns of label weights.
+        The styles, in the order of the columns of label weights (fitted on
+        labels only).
+    n_context_ : int
+        Columns of the context: the number of styles for a model fitted on
+        labels.
     visible_factors_ : ndarray of shape (n_features, n_factors)
         ``W_v``: the visible units' weights to the undirected factors.
     hidden_factors_ : ndarray of shape (n_components, n_factors)
@@ -124,8 +130,8 @@ class FactoredCRBM(BaseStyleModel):
         ``P_B``.
     hidden_from_factors_ : ndarray of shape (n_components, n_factors)
         ``B_h``.
-    label_features_ : ndarray of shape (n_classes, n_style_features)
-        ``R``: the style features of each label.
+    label_features_ : ndarray of shape (n_context, n_style_features)
+        ``R``: the style features of each label (each column of the context).
     style_factors_ : ndarray of shape (n_style_features, n_factors)
         ``Z``: the style features' weights to every kind of factor (with
         ``shared_style_weights``; otherwise ``style_undirected_``,
@@ -173,11 +179,8 @@ class FactoredCRBM(BaseStyleModel):
     """
 
     _parameter_constraints: dict = {
-        **{
-            name: constraint
-            for name, constraint in BaseStyleModel._parameter_constraints.items()
-            if name != "hidden_order"
-        },
+        **BaseStyleModel._parameter_constraints,
+        "order": [Interval(Integral, 0, None, closed="left")],
         "n_components": [Interval(Integral, 1, None, closed="left")],
         "n_factors": [Interval(Integral, 1, None, closed="left")],
         "n_style_features": [Interval(Integral, 1, None, closed="left")],
@@ -269,17 +272,13 @@ class FactoredCRBM(BaseStyleModel):
         self.random_state = random_state
         self.verbose = verbose
 
-    @property
-    def _hidden_order(self):
-        return self.order
-
-    def _new_layer(self, n_features, dtype):
+    def _new_layer(self, n_features, n_context, dtype):
         return FactoredLayer(
             n_features,
             self.n_components,
             self.n_factors,
             self.n_style_features,
-            len(self.classes_),
+            n_context,
             self.order,
             dtype,
             shared_style_weights=self.shared_style_weights,

@@ -1,6 +1,6 @@
 """Gibbs sampling and mean-field prediction of frames, through one layer or a stack.
 
-Everything here works on :class:`~sklearn_crbm._layer.FrameRBMs`, a layer
+Everything here works on :class:`~sklearn_crbm.layers.FrameRBMs`, a layer
 given each frame's past and context, so it serves every kind of layer.  A
 stack is a list of frame RBMs, bottom first: layer ``k + 1``'s visible
 units are layer ``k``'s hidden units.
@@ -10,16 +10,14 @@ import math
 
 import numpy as np
 
-from ._layer import logistic
-from .utils._array_api import array_ops, copy_array
-from .utils._random import _MIN_BIT_DRAWS, sample_bernoulli, uniform
+from .utils._array_api import copy_array
+from .utils._random import _MIN_BIT_DRAWS, uniform
 
 __all__ = [
     "HiddenSampler",
     "gibbs_frames",
     "mean_field_prediction",
     "observed_log_likelihood",
-    "sample_visible_states",
     "stacked_gibbs_frames",
     "stacked_prediction",
 ]
@@ -107,19 +105,6 @@ class HiddenSampler:
         return ops.less(activation, 1, out=draws)
 
 
-def sample_visible_states(rbms, means, rng, out=None):
-    """Draws from p(v | h, past) given its means: N(mean, s^2) or Bernoulli(mean).
-
-    ``out`` (not ``means`` itself) receives the draws if given.
-    """
-    if rbms.binary:
-        return sample_bernoulli(means, rng, out=out)
-    noise = rng.standard_normal(means.shape, dtype=means.dtype, out=out)
-    if rbms.visible_std is not None:
-        noise *= rbms.visible_std
-    return rbms.ops.add(means, noise, out=noise)
-
-
 def gibbs_frames(
     rbms,
     start,
@@ -168,10 +153,7 @@ def gibbs_frames(
             )
             rbms.visible_mean(hidden, out=visible)
             if sample_visibles:
-                visible, drawn = (
-                    sample_visible_states(rbms, visible, rng, out=drawn),
-                    visible,
-                )
+                visible, drawn = rbms.sample_visibles(visible, rng, out=drawn), visible
             if observed_mask is not None:
                 ops.copyto(visible, start, where=observed_mask)
     if sample_visibles:
@@ -190,9 +172,7 @@ def mean_field_prediction(rbms, n_steps):
     uses nothing but the model and the past) and alternates hidden
     probabilities and visible means ``n_steps`` times.
     """
-    visible = copy_array(rbms.visible_bias)
-    if rbms.binary:
-        visible = logistic(visible, out=visible)
+    visible = rbms.units.activate(copy_array(rbms.visible_bias))
     for _ in range(n_steps):
         visible = rbms.visible_mean(rbms.hidden_probabilities(visible))
     return visible
@@ -292,13 +272,6 @@ def observed_log_likelihood(bottom, prediction, visible, observed_mask):
     -------
     log_likelihood : ndarray of shape (n,)
     """
-    ops = array_ops(prediction)
-    if bottom.binary:
-        eps = ops.finfo(prediction.dtype).eps
-        prediction = ops.clip(prediction, eps, 1 - eps)
-        terms = ops.where(visible > 0.5, ops.log(prediction), ops.log1p(-prediction))
-        return ops.sum(ops.where(observed_mask, terms, 0), axis=1)
-    residual = ops.where(observed_mask, visible - prediction, 0)
-    if bottom.visible_std is not None:
-        residual /= bottom.visible_std
-    return -0.5 * ops.einsum("ij,ij->i", residual, residual)
+    return bottom.units.observed_log_likelihood(
+        bottom, prediction, visible, observed_mask
+    )

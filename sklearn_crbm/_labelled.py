@@ -5,65 +5,14 @@ from numbers import Integral, Real
 from sklearn.utils._param_validation import Interval, StrOptions
 
 from ._base import FittedParameter
-from ._crbm_layer import CRBM_GROUPS, CRBMLayer
-from ._parameters import ParameterGroup, small_normal
 from ._style_model import BaseStyleModel
+from .layers._crbm import ORDER_CONSTRAINTS, CRBMLayer, hidden_order_of
 
 __all__ = ["LabelledCRBM"]
 
-LABELLED_GROUPS = CRBM_GROUPS + (
-    ParameterGroup(
-        "label_weights",
-        lambda p: (p.n_features + p.n_components, p.n_classes),
-        lambda p, rng: small_normal(rng, p.label_weights.shape, p.dtype),
-        decayed=True,
-    ),
-)
-
-
-class LabelledLayer(CRBMLayer):
-    """A CRBM layer whose dynamic biases add ``L y``, ``y`` the frame's label weights.
-
-    ``label_weights`` (n_features + n_components, n_classes) stacks the
-    label-to-visible rows over the label-to-hidden rows, as ``dynamic``
-    stacks the autoregressive weights over the past-to-hidden ones.
-    """
-
-    groups = LABELLED_GROUPS
-
-    def __init__(self, n_features, n_components, n_classes, order, hidden_order, dtype):
-        self.n_classes = n_classes
-        super().__init__(
-            n_features, n_components, order, hidden_order, "gaussian", dtype
-        )
-
-    @property
-    def label_to_visible(self):
-        return self.label_weights[: self.n_features]
-
-    @property
-    def label_to_hidden(self):
-        return self.label_weights[self.n_features :]
-
-    def frame_rbms(self, history, context=None, *, out=None):
-        rbms = super().frame_rbms(history, out=out)
-        labelled = self.ops.matmul(context, self.label_weights.T)
-        rbms.visible_bias += labelled[:, : self.n_features]
-        rbms.hidden_bias += labelled[:, self.n_features :]
-        return rbms
-
-    def conditioner(self):
-        return self.frame_rbms
-
-    def cd_statistics(self, visible, history, context, *args, out, workspace, **kw):
-        out, error = super().cd_statistics(
-            visible, history, context, *args, out=out, workspace=workspace, **kw
-        )
-        # [v - v_recon, h_data - h_recon], scaled: the labels' statistics, as
-        # the directed weights' are those of the history
-        delta = workspace.delta[: visible.shape[0], ...]
-        out.label_weights[...] = self.ops.matmul(delta.T, context)
-        return out, error
+# The layer of a LabelledCRBM pickled in format 1 before contexts were
+# real-valued: a CRBM layer whose context is the label weights.
+LabelledLayer = CRBMLayer
 
 
 class LabelledCRBM(BaseStyleModel):
@@ -122,10 +71,14 @@ class LabelledCRBM(BaseStyleModel):
     intercept_visible_ : ndarray of shape (n_features,)
     autoregressive_ : ndarray of shape (order, n_features, n_features)
     past_to_hidden_ : ndarray of shape (hidden_order, n_components, n_features)
-    label_to_visible_ : ndarray of shape (n_features, n_classes)
-        ``L_v``: what each style adds to the visible biases.
-    label_to_hidden_ : ndarray of shape (n_components, n_classes)
+    label_to_visible_ : ndarray of shape (n_features, n_context)
+        ``L_v``: what each style (each column of the context) adds to the
+        visible biases.
+    label_to_hidden_ : ndarray of shape (n_components, n_context)
         ``L_h``: what each style adds to the hidden biases.
+    n_context_ : int
+        Columns of the context: the number of styles for a model fitted on
+        labels.
     seed_windows_ : ndarray of shape (n_windows, width, n_features)
     reconstruction_error_ : float
     n_iter_ : int
@@ -162,6 +115,7 @@ class LabelledCRBM(BaseStyleModel):
 
     _parameter_constraints: dict = {
         **BaseStyleModel._parameter_constraints,
+        **ORDER_CONSTRAINTS,
         "n_components": [Interval(Integral, 1, None, closed="left")],
         "n_gibbs": [Interval(Integral, 0, None, closed="left")],
         "batching": [StrOptions({"balanced", "shuffled"})],
@@ -173,8 +127,8 @@ class LabelledCRBM(BaseStyleModel):
     intercept_visible_ = FittedParameter("visible_bias")
     autoregressive_ = FittedParameter("autoregressive")
     past_to_hidden_ = FittedParameter("past_to_hidden")
-    label_to_visible_ = FittedParameter("label_to_visible")
-    label_to_hidden_ = FittedParameter("label_to_hidden")
+    label_to_visible_ = FittedParameter("context_to_visible")
+    label_to_hidden_ = FittedParameter("context_to_hidden")
 
     def __init__(
         self,
@@ -231,12 +185,13 @@ class LabelledCRBM(BaseStyleModel):
         self.random_state = random_state
         self.verbose = verbose
 
-    def _new_layer(self, n_features, dtype):
-        return LabelledLayer(
+    def _new_layer(self, n_features, n_context, dtype):
+        return CRBMLayer(
             n_features,
             self.n_components,
-            len(self.classes_),
             self.order,
-            self._hidden_order,
+            hidden_order_of(self),
+            "gaussian",
             dtype,
+            n_context=n_context,
         )

@@ -50,7 +50,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ._layer import logistic
+from .layers._base import clipped_logit, draw_bernoulli, logistic
 from .utils._array_api import array_ops, copy_array
 
 # Hidden configurations summed per block by the exact enumeration.
@@ -61,9 +61,6 @@ MAX_EXACT_COMPONENTS = 24
 _AIS_ROWS = 16384
 # Mean-field iterations that find each frame's fixed point (the AIS base).
 _MEAN_FIELD_STEPS = 20
-# Base probabilities are kept this far from 0 and 1 (finite logits).
-_BASE_CLIP = 1e-4
-_LOG_SQRT_2PI = 0.5 * math.log(2 * math.pi)
 # A model without history anneals its one partition function with this many
 # times the per-frame distributions, from this many frames at most.
 SHARED_STEPS = 5
@@ -122,9 +119,7 @@ def log_partition_exact(rbms):
             f"{MAX_EXACT_COMPONENTS} hidden units. Use method='ais'."
         )
     total = 2**n_components
-    block = _EXACT_BLOCK
-    if rbms.binary:  # the softplus term is (frames, block, features)
-        block = max(1, min(block, (1 << 22) // max(1, rbms.n_frames * rbms.n_features)))
+    block = rbms.units.exact_block(_EXACT_BLOCK, rbms)
     ops = rbms.ops
     weights = rbms.shared_weights
     log_z = ops.full(rbms.n_frames, -math.inf, dtype=ops.float64)
@@ -141,7 +136,7 @@ def log_partition_exact(rbms):
                 ]
             )
         log_z = ops.logaddexp(log_z, _logsumexp_rows(terms))
-    return log_z + rbms.gaussian_normaliser()
+    return log_z + rbms.log_normaliser()
 
 
 def _configuration_terms(rbms, hidden, u):
@@ -150,15 +145,8 @@ def _configuration_terms(rbms, hidden, u):
     ``u`` holds ``W.T h`` of every configuration (shape ``(configs,
     n_features)``), the same for every frame of ``rbms``.
     """
-    ops = rbms.ops
     terms = rbms.hidden_bias @ hidden.T
-    if rbms.binary:
-        softplus = ops.logaddexp(0, rbms.visible_bias[:, None, :] + u)
-        terms += ops.sum(softplus, axis=2)
-    else:
-        terms += (rbms.visible_bias / rbms.scale) @ u.T
-        terms += 0.5 * ops.einsum("ij,ij->i", u, u)
-    return terms
+    return rbms.units.add_configuration_terms(rbms, u, terms)
 
 
 def _own_configuration_terms(rbms, row, hidden):
@@ -198,26 +186,16 @@ def mean_field_base(rbms, start=None, n_steps=_MEAN_FIELD_STEPS):
         Gaussian: the base mean ``m``; binary: the base logits.
     hidden_logits : ndarray of shape (n_frames, n_components)
     """
-    ops = rbms.ops
+    units = rbms.units
     field = copy_array(rbms.visible_bias)
     if start is not None:
-        field = (
-            _logit(start) if rbms.binary else ops.astype(start, ops.float64, copy=True)
-        )
+        field = units.field_of(start)
     hidden = None
     for _ in range(n_steps):
-        visible = logistic(field) if rbms.binary else field
+        visible = units.mean_copy(field)
         hidden = logistic(rbms.hidden_input(visible))
         field = rbms.visible_bias + rbms.interaction_field(hidden)
-    if rbms.binary:
-        field = _logit(logistic(field))
-    return field, _logit(hidden)
-
-
-def _logit(probability):
-    ops = array_ops(probability)
-    p = ops.clip(probability, _BASE_CLIP, 1 - _BASE_CLIP)
-    return ops.log(p) - ops.log1p(-p)
+    return units.base_field(field), clipped_logit(hidden)
 
 
 class _Annealing:
@@ -239,25 +217,16 @@ class _Annealing:
         self.dtype = ops.float32
         visible_base, hidden_logits = mean_field_base(rbms, start)
         rows = np.repeat(np.arange(rbms.n_frames), n_chains)
-        self.binary = rbms.binary
+        self.units = units = rbms.units
         self.n_rows = len(rows)
         self.log_base_normaliser = ops.take(
             ops.sum(ops.logaddexp(0, hidden_logits), axis=1), rows
         )
-        if rbms.binary:
-            self.log_base_normaliser += ops.take(
-                ops.sum(ops.logaddexp(0, visible_base), axis=1), rows
-            )
-        else:
-            self.log_base_normaliser += rbms.gaussian_normaliser()
+        self.log_base_normaliser += units.base_log_normaliser(rbms, visible_base, rows)
         scale = rbms.scale
         shift = rbms.visible_bias - visible_base  # c_hat - m
-        gradient = shift if rbms.binary else shift / scale**2
-        offset = 0.0
-        if not rbms.binary:
-            middle = 0.5 * (rbms.visible_bias + visible_base)
-            offset = ops.take(ops.einsum("ij,ij->i", gradient, middle), rows)
-        self.change_offset = offset
+        gradient = units.change_gradient(shift, scale)
+        self.change_offset = units.change_offset(rbms, visible_base, gradient, rows)
 
         def rows_of(array):
             return ops.ascontiguousarray(ops.take(array, rows, axis=0), self.dtype)
@@ -277,11 +246,7 @@ class _Annealing:
         self.work = ops.empty_like(self.difference)
 
     def sample_base(self, rng):
-        if self.binary:
-            return _bernoulli(logistic(copy_array(self.visible_base)), rng)
-        noise = rng.standard_normal(self.visible_base.shape, dtype=self.dtype)
-        noise *= self.scale
-        return self.ops.add(self.visible_base, noise, out=noise)
+        return self.units.sample_field(copy_array(self.visible_base), self.scale, rng)
 
     def step(self, visible, beta, previous_beta):
         """``log f_beta(v) - log f_previous(v)`` of every row (float64).
@@ -306,17 +271,12 @@ class _Annealing:
 
     def gibbs(self, beta, logits, rng):
         """A block-Gibbs step at ``beta`` from hidden logits ``a + beta d(v)``."""
-        hidden = _bernoulli(logistic(logits, out=self.work), rng)
+        hidden = draw_bernoulli(logistic(logits, out=self.work), rng)
         field = self.rbms.interaction_field(hidden)
         field += self.shift
         field *= beta
         field += self.visible_base
-        if self.binary:
-            return _bernoulli(logistic(field, out=field), rng)
-        noise = rng.standard_normal(field.shape, dtype=self.dtype)
-        noise *= self.scale
-        field += noise
-        return field
+        return self.units.sample_field(field, self.scale, rng)
 
 
 def _softplus(x, out):
@@ -328,12 +288,6 @@ def _softplus(x, out):
     out = ops.log1p(out, out=out)
     out += ops.maximum(x, 0)
     return out
-
-
-def _bernoulli(probability, rng):
-    ops = array_ops(probability)
-    draws = rng.random(probability.shape, dtype=probability.dtype)
-    return ops.astype(ops.less(draws, probability), probability.dtype)
 
 
 def annealing_schedule(n_steps):
@@ -525,7 +479,6 @@ def frame_log_likelihood(
     visible,
     chunks,
     *,
-    shared=False,
     method="auto",
     n_steps=50,
     n_chains=2,
@@ -539,14 +492,12 @@ def frame_log_likelihood(
     visible : ndarray of shape (n_frames, n_features)
         The frames, indexed by the rows of ``chunks``.
     chunks : iterable of (rows, FrameRBMs)
-        The frames' RBMs, as :func:`~sklearn_crbm._layer.sequence_frame_rbms`
-        yields them.
-    shared : bool, default=False
-        Whether every frame has the same RBM (a layer without history or
-        context): its one partition function is annealed once
-        (:func:`shared_log_partition_ais`) with ``SHARED_STEPS * n_steps``
-        distributions and ``n_chains`` chains from each of up to
-        ``SHARED_STARTS`` frames.
+        The frames' RBMs, as :func:`~sklearn_crbm.layers.sequence_frame_rbms`
+        yields them.  When every frame has the same RBM (``frame_invariant``:
+        a layer without history or context), its one partition function is
+        annealed once (:func:`shared_log_partition_ais`) with
+        ``SHARED_STEPS * n_steps`` distributions and ``n_chains`` chains from
+        each of up to ``SHARED_STARTS`` frames.
     method : {"auto", "exact", "ais"}, default="auto"
     n_steps, n_chains : int, default=50, 2
         AIS intermediate distributions and chains per frame.
@@ -562,7 +513,7 @@ def frame_log_likelihood(
     ops = array_ops(visible)
     with np.errstate(under="ignore"):  # exp of very negative numbers is 0
         parts = _chunk_log_likelihoods(
-            visible, chunks, shared, method, n_steps, n_chains, reverse, rng
+            visible, chunks, method, n_steps, n_chains, reverse, rng
         )
     return LogLikelihood(
         ops.concatenate([p[0] for p in parts]),
@@ -572,15 +523,13 @@ def frame_log_likelihood(
     )
 
 
-def _chunk_log_likelihoods(
-    visible, chunks, shared, method, n_steps, n_chains, reverse, rng
-):
+def _chunk_log_likelihoods(visible, chunks, method, n_steps, n_chains, reverse, rng):
     shared_partition = None
     parts = []
     for rows, rbms in chunks:
         ops = rbms.ops
         rbms = rbms.astype(ops.float64)  # AIS sums many small log ratios
-        if shared:
+        if rbms.frame_invariant:
             if shared_partition is None:
                 shared_partition = _shared_log_partition(
                     rbms,
@@ -653,7 +602,7 @@ def stack_log_likelihood_bound(stack, visible, *, n_samples, rng, **top):
         for rbms in stack[:-1]:
             rbms = rbms.take(rows)
             logits = rbms.hidden_input(state)
-            hidden = _bernoulli(logistic(copy_array(logits)), rng)
+            hidden = draw_bernoulli(logistic(copy_array(logits)), rng)
             log_weight -= ops.sum(hidden * logits - ops.logaddexp(0, logits), axis=1)
             log_weight += _log_visible_given_hidden(rbms, state, hidden)
             state = hidden
@@ -666,12 +615,4 @@ def stack_log_likelihood_bound(stack, visible, *, n_samples, rng, **top):
 
 def _log_visible_given_hidden(rbms, visible, hidden):
     """``log p(v | h)`` per row: ``N(c_hat + s W.T h, s^2)`` or Bernoulli."""
-    ops = rbms.ops
-    field = rbms.interaction_field(hidden)
-    if rbms.binary:
-        field += rbms.visible_bias
-        return ops.sum(visible * field - ops.logaddexp(0, field), axis=1)
-    residual = (visible - rbms.visible_bias - field) / rbms.scale
-    return (
-        -0.5 * ops.einsum("ij,ij->i", residual, residual) - rbms.gaussian_normaliser()
-    )
+    return rbms.units.log_density(rbms, visible, rbms.interaction_field(hidden))

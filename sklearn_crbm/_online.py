@@ -4,7 +4,7 @@ Every model's ``sample`` (:class:`~sklearn_crbm.ConditionalRBM`,
 :class:`~sklearn_crbm.StackedCRBM`, :class:`~sklearn_crbm.FactoredCRBM`,
 :class:`~sklearn_crbm.LabelledCRBM`) and
 :class:`~sklearn_crbm.impute.CRBMImputer` call :func:`run_online`, with
-one layer or a stack, of any kind (:mod:`sklearn_crbm._layer`):
+one layer or a stack, of any kind (:mod:`sklearn_crbm.layers`):
 
 - generation: nothing observed, every frame of every sequence drawn from a
   seed history;
@@ -31,7 +31,7 @@ from ._gibbs import (
     stacked_gibbs_frames,
     stacked_prediction,
 )
-from ._layer import sequence_hidden_probabilities
+from .layers._base import sequence_hidden_probabilities
 from .utils._array_api import array_ops, copy_array, to_numpy
 from .utils._sequences import Sequences
 
@@ -262,7 +262,7 @@ class Offsets:
         self.sums = ops.zeros((n_chains, n_sequences, bottom.n_features), dtype)
         self.counts = ops.zeros((n_sequences, bottom.n_features), dtype)
         self.shrinkage = shrinkage
-        self.binary = bottom.binary
+        self.units = bottom.visible_units
 
     def update(self, prediction, frames, observed):
         """Add the residuals of ``frames`` (one per sequence) where ``observed``.
@@ -280,7 +280,7 @@ class Offsets:
         # a channel never observed has a zero sum; the floor spares 0 / 0
         denominator = ops.maximum(self.counts + self.shrinkage, 1)
         frames = frames + ops.where(missing, self.sums / denominator, 0)
-        return ops.clip(frames, 0, 1) if self.binary else frames
+        return self.units.clip(frames)
 
     def reorder(self, chains):
         """The chains' offsets follow their pasts (:meth:`History.reorder`)."""
@@ -497,15 +497,19 @@ def _fill(
         clamp = ops.broadcast_to(~frame_missing, shape)
         current = ops.broadcast_to(frames, shape)
         if history is None:
+            # the first frame's context is its past's (the chains' own, else)
+            past_context = chain_context
+            if context is not None:
+                past_context = ops.broadcast_to(context, (n_chains, *context.shape))
             if drawn.any():
                 # No past: the frame stands in for it, and the fill is
                 # repeated with the latest fill as the past.
                 for _ in range(FIRST_FRAME_ROUNDS):
                     own_past = History.from_frames(
-                        layers, current[:, :, None, :], chain_context
+                        layers, current[:, :, None, :], past_context
                     )
                     current = draw(current, own_past.frame_rbms(context), clamp)[0]
-            history = History.from_frames(layers, current[:, :, None, :], chain_context)
+            history = History.from_frames(layers, current[:, :, None, :], past_context)
             yield step, current
             continue
         # with a context of their own the chains' every observation is

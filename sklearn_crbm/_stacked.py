@@ -3,14 +3,15 @@
 from numbers import Integral, Real
 
 import numpy as np
-from sklearn.base import _fit_context
-from sklearn.utils import check_random_state
+from sklearn.base import _fit_context, clone
+from sklearn.utils import check_random_state, get_tags
 from sklearn.utils._array_api import get_namespace
-from sklearn.utils._param_validation import Interval
+from sklearn.utils._param_validation import HasMethods, Interval
 from sklearn.utils.validation import validate_data
 
 from ._base import BaseCRBM
 from ._crbm import ConditionalRBM
+from ._style_model import _on_host
 from .utils._array_api import array_ops
 from .utils._random import rng_from
 from .utils._sequences import check_sequence_ids
@@ -80,11 +81,24 @@ class StackedCRBM(BaseCRBM):
         unless ``sample`` is given its own, generation.
     verbose : int, default=0
         Passed to every layer: print progress every ``verbose`` epochs.
+    estimator : estimator, default=None
+        The model of every layer, for a stack of another kind: an unfitted
+        model of one conditional layer (:class:`LabelledCRBM`,
+        :class:`FactoredCRBM`, a model of a new kind of layer), cloned for
+        each layer with its ``n_components`` from ``n_components``, its
+        ``random_state`` drawn from the stack's and, above the bottom,
+        binary visibles where it has a ``visible_type``; its other
+        parameters are its own (the stack's ``order`` to ``verbose``
+        configure the default).  None: a :class:`ConditionalRBM` with the
+        stack's parameters.  Labels ``y`` given to :meth:`fit` reach every
+        layer.
 
     Attributes
     ----------
     layers_ : list of ConditionalRBM
         The fitted layers, bottom (Gaussian visibles) first.
+    n_context_ : int
+        Columns of the context the stack was fitted with (0: none).
     seed_windows_ : ndarray of shape (n_windows, history_length, n_features)
         Windows of consecutive training frames kept to seed :meth:`sample`.
     random_state_ : RandomState instance
@@ -133,6 +147,9 @@ class StackedCRBM(BaseCRBM):
     (90, 6)
     """
 
+    # A stack pickled before ``estimator`` existed stacks ConditionalRBMs.
+    estimator = None
+
     # The hyper-parameters every layer takes from the stack as they are.
     _layer_parameters = (
         "order",
@@ -158,6 +175,7 @@ class StackedCRBM(BaseCRBM):
         "n_components": [Interval(Integral, 1, None, closed="left"), "array-like"],
         "history_noise": [Interval(Real, 0, None, closed="left"), "array-like"],
         "random_state": ["random_state"],
+        "estimator": [HasMethods(["fit", "transform", "conditional_layers"]), None],
     }
 
     def __init__(
@@ -179,6 +197,7 @@ class StackedCRBM(BaseCRBM):
         n_iter=200,
         random_state=None,
         verbose=0,
+        estimator=None,
     ):
         self.n_components = n_components
         self.order = order
@@ -196,6 +215,7 @@ class StackedCRBM(BaseCRBM):
         self.n_iter = n_iter
         self.random_state = random_state
         self.verbose = verbose
+        self.estimator = estimator
 
     # ------------------------------------------------------------ structure
 
@@ -214,16 +234,6 @@ class StackedCRBM(BaseCRBM):
             )
         return [int(s) for s in sizes]
 
-    @property
-    def history_length(self):
-        """Past frames the whole stack looks at: the sum of its layers' lags.
-
-        :meth:`sample` needs this many seed frames and :meth:`score` judges
-        frames with this many past frames in their sequence; ``2 * order``
-        for two layers.
-        """
-        return self._n_lags * len(self._layer_sizes())
-
     def _history_noises(self, n_layers):
         noise = self.history_noise
         if isinstance(noise, Real) and not isinstance(noise, bool):
@@ -239,16 +249,22 @@ class StackedCRBM(BaseCRBM):
         return [float(v) for v in values]
 
     def _new_layer(self, n_components, visible_type, seed, history_noise):
-        params = self.get_params(deep=False)
-        return ConditionalRBM(
-            n_components,
-            visible_type=visible_type,
-            history_noise=history_noise,
-            random_state=seed,
-            **{name: params[name] for name in self._layer_parameters},
-        )
+        if self.estimator is None:
+            params = self.get_params(deep=False)
+            return ConditionalRBM(
+                n_components,
+                visible_type=visible_type,
+                history_noise=history_noise,
+                random_state=seed,
+                **{name: params[name] for name in self._layer_parameters},
+            )
+        layer = clone(self.estimator)
+        own = dict(n_components=n_components, random_state=seed)
+        if "visible_type" in layer.get_params(deep=False):
+            own["visible_type"] = visible_type
+        return layer.set_params(**own)
 
-    def _check_fit_input(self, X, sequence_ids, reset):
+    def _check_fit_input(self, X, sequence_ids, context, reset):
         xp = get_namespace(X)[0]
         if not reset:
             self._check_namespace(X, "partial_fit")
@@ -259,40 +275,53 @@ class StackedCRBM(BaseCRBM):
             reset=reset,
         )
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
-        needed = self.history_length + 1
+        lags = [layer.n_lags for layer in self._planned_layers(X.shape[1])]
+        needed = sum(lags) + 1
         longest = int(sequences.lengths.max()) if len(sequences.lengths) else 0
         if longest < needed:
             noun = "sample" if longest == 1 else "samples"
             raise ValueError(
                 f"A stack of {len(self._layer_sizes())} layers of order "
-                f"{self._n_lags} needs sequences of at least {needed} frames (each "
-                f"layer drops the first {self._n_lags} frames of every sequence), "
+                f"{lags[0]} needs sequences of at least {needed} frames (each "
+                f"layer drops the first {lags[0]} frames of every sequence), "
                 f"but the longest sequence has {longest} {noun}. Pass longer "
                 "sequences (check sequence_ids), fewer layers or a lower order."
             )
-        return X, sequences
+        return X, sequences, self._fit_context(X, None, context, reset)
 
-    def _pass_up(self, layer, X, ids):
-        """Hidden probabilities of ``layer`` on its valid frames, with their ids."""
-        valid = check_sequence_ids(ids, X.shape[0]).valid_frames(layer._n_lags)
-        hidden = layer.transform(X, sequence_ids=ids)
-        return array_ops(hidden).take(hidden, valid, axis=0), ids[valid]
+    def _pass_up(self, layer, X, y, ids, context):
+        """Hidden probabilities of ``layer`` on its valid frames, with their
+        labels, ids and contexts."""
+        valid = check_sequence_ids(ids, X.shape[0]).valid_frames(layer.history_length)
+        # the labels as fit took them (a model without labels ignores them)
+        hidden = layer._transform_training_data(X, y, ids, context)
+        ops = array_ops(hidden)
+        if context is not None:
+            context = ops.take(context, valid, axis=0)
+        # labels go up to layers that take them (a style model requires them)
+        takes_labels = y is not None and get_tags(layer).target_tags.required
+        y = _on_host(y)[valid] if takes_labels else None
+        return ops.take(hidden, valid, axis=0), y, ids[valid], context
 
     # ------------------------------------------------------------------ fit
 
     @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y=None, *, sequence_ids=None):
+    def fit(self, X, y=None, *, sequence_ids=None, context=None):
         """Train the layers greedily, bottom first.
 
         Parameters
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
+        y : array-like of shape (n_frames,), default=None
+            Labels for the layers of a style model (``estimator``); ignored
+            by :class:`ConditionalRBM` layers.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's real-valued context, which every layer takes (a
+            :class:`ConditionalRBM` adds it to its dynamic biases).
 
         Returns
         -------
@@ -301,7 +330,9 @@ class StackedCRBM(BaseCRBM):
         """
         sizes = self._layer_sizes()
         noises = self._history_noises(len(sizes))
-        X, sequences = self._check_fit_input(X, sequence_ids, reset=True)
+        X, sequences, context = self._check_fit_input(
+            X, sequence_ids, context, reset=True
+        )
         self.random_state_ = check_random_state(self.random_state)
         ids = sequences.per_frame_ids()
         self.layers_ = []
@@ -311,16 +342,16 @@ class StackedCRBM(BaseCRBM):
             layer = self._new_layer(
                 size, "gaussian" if k == 0 else "binary", seed, noises[k]
             )
-            layer.fit(data, sequence_ids=ids)
+            layer.fit(data, y, sequence_ids=ids, context=context)
             self.layers_.append(layer)
             if k + 1 < len(sizes):
-                data, ids = self._pass_up(layer, data, ids)
+                data, y, ids, context = self._pass_up(layer, data, y, ids, context)
         self._keep_seeds(X, sequences)
         return self
 
     @limit_blas_threads(batch_rows)
     @_fit_context(prefer_skip_nested_validation=True)
-    def partial_fit(self, X, y=None, *, sequence_ids=None):
+    def partial_fit(self, X, y=None, *, sequence_ids=None, context=None):
         """Train every layer for one epoch on the given sequences.
 
         The first call creates the layers.  Each call trains the bottom
@@ -332,10 +363,14 @@ class StackedCRBM(BaseCRBM):
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : None
-            Ignored.
+        y : array-like of shape (n_frames,), default=None
+            Labels for the layers of a style model (``estimator``); ignored
+            by :class:`ConditionalRBM` layers.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's real-valued context, which every layer takes (a
+            :class:`ConditionalRBM` adds it to its dynamic biases).
 
         Returns
         -------
@@ -345,7 +380,9 @@ class StackedCRBM(BaseCRBM):
         sizes = self._layer_sizes()
         noises = self._history_noises(len(sizes))
         first_call = not hasattr(self, "layers_")
-        X, sequences = self._check_fit_input(X, sequence_ids, reset=first_call)
+        X, sequences, context = self._check_fit_input(
+            X, sequence_ids, context, reset=first_call
+        )
         if first_call:
             self.random_state_ = check_random_state(self.random_state)
             self.layers_ = [
@@ -360,14 +397,23 @@ class StackedCRBM(BaseCRBM):
         ids = sequences.per_frame_ids()
         data = X
         for k, layer in enumerate(self.layers_):
-            layer.partial_fit(data, sequence_ids=ids)
+            layer.partial_fit(data, y, sequence_ids=ids, context=context)
             if k + 1 < len(self.layers_):
-                data, ids = self._pass_up(layer, data, ids)
+                data, y, ids, context = self._pass_up(layer, data, y, ids, context)
         self._keep_seeds(X, sequences, merge=True)
         return self
 
     def _layers(self):
-        return [layer for model in self.layers_ for layer in model._layers()]
+        return [layer for model in self.layers_ for layer in model.conditional_layers()]
+
+    def _planned_layers(self, n_features):
+        layers = []
+        for k, size in enumerate(self._layer_sizes()):
+            visible_type = "gaussian" if k == 0 else "binary"
+            model = self._new_layer(size, visible_type, None, 0.0)
+            layers += model._planned_layers(n_features)
+            n_features = size
+        return layers
 
     def _chain_rng(self, rng):
         # the top layer's chains draw from a generator of their own, seeded

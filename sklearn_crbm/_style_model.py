@@ -1,17 +1,20 @@
 """What a layer model conditioned on a style per frame adds: labels in and out.
 
-A style model's layer takes every frame's label weights ``y`` (one-hot for a
-labelled frame, any non-negative weights that sum to 1 for a blend) as its
-context.  :class:`BaseStyleModel` turns labels into those weights in
-``fit``, ``transform``, ``score`` and ``sample``, names the style of a
-sequence by Bayes' rule (``predict_proba``), and scores frames whose style
-is not given under the mixture of styles, each weighted by its posterior
-given the frames before.
+A style model fitted on labels takes every frame's label weights ``y``
+(one-hot for a labelled frame, any non-negative weights that sum to 1 for a
+blend) as its context.  :class:`BaseStyleModel` turns labels into those
+weights (``y`` in ``fit`` and ``score``, ``style`` in the other methods of
+:class:`~sklearn_crbm._base.BaseCRBM`), names the style of a sequence by
+Bayes' rule (``classes_``, ``predict``, ``predict_proba``), infers the
+context of frames given none from each sequence's posterior, and scores
+them under the mixture of styles, each weighted by its posterior given the
+frames before.  Fitted on a real-valued ``context`` instead, it is a model
+of that context, without the classifier.
 """
 
 import hashlib
 import weakref
-from numbers import Integral, Real
+from numbers import Integral
 
 import numpy as np
 from scipy.special import logsumexp
@@ -19,11 +22,10 @@ from sklearn.base import clone
 from sklearn.utils._array_api import _estimator_with_converted_arrays
 from sklearn.utils.validation import check_is_fitted
 
-from ._base import check_count, seed_frames
 from ._base_layer import BaseLayerModel
 from .utils._array_api import array_ops, to_numpy
 from .utils._random import rng_from
-from .utils._threads import frame_rows, limit_blas_threads, sequence_rows
+from .utils._threads import frame_rows, limit_blas_threads
 
 __all__ = ["BaseStyleModel", "check_label_weights"]
 
@@ -86,7 +88,8 @@ class BaseStyleModel(BaseLayerModel):
     ``fit(X, y)`` takes one label per frame (``classes_`` as a classifier
     has them) or a 2-D array of label weights per frame.  Where a method
     takes ``style``, it is a label (every frame), one label per frame, or
-    label weights ``(n_frames, n_classes)``.
+    label weights ``(n_frames, n_classes)``.  ``fit(X, context=...)``
+    takes a real-valued context instead (no ``classes_``).
     """
 
     _parameter_constraints: dict = {
@@ -94,19 +97,40 @@ class BaseStyleModel(BaseLayerModel):
         "priors": ["array-like", None],
     }
 
-    __metadata_request__transform = {"sequence_ids": True, "style": True}
+    __metadata_request__transform = {
+        "sequence_ids": True,
+        "context": True,
+        "style": True,
+    }
     __metadata_request__predict = {"sequence_ids": True}
     __metadata_request__predict_proba = {"sequence_ids": True}
 
+    _context_hint = ", or style= for a model fitted on labels"
+
     # -------------------------------------------------------------- labels
 
-    def _labels_context(self, y, X, reset):
-        if y is None:
+    @property
+    def _labelled(self):
+        """Whether the model was fitted on labels (its context: label weights)."""
+        return hasattr(self, "classes_")
+
+    def _fit_context(self, X, y, context, reset):
+        if reset and y is None and context is None:
             raise ValueError(
                 f"{type(self).__name__} requires y to be passed, but the target y "
                 "is None: give the style label of every frame (an array of shape "
-                "(n_frames,)) or label weights of shape (n_frames, n_classes)."
+                "(n_frames,)) or label weights of shape (n_frames, n_classes), or a "
+                "real-valued context= of shape (n_frames, n_context)."
             )
+        return super()._fit_context(X, y, context, reset)
+
+    def _labels_context(self, y, X, reset):
+        if y is None:
+            if reset:  # a model of a real-valued context names no classes
+                vars(self).pop("classes_", None)
+            return None
+        if not (reset or self._labelled):
+            raise self._unlabelled_error("y")
         n_frames = X.shape[0]
         labels = _on_host(y)
         if labels.ndim == 2 and labels.dtype.kind in "biuf":
@@ -160,6 +184,51 @@ class BaseStyleModel(BaseLayerModel):
             )
         return np.eye(len(classes))[index]
 
+    def _score_context(self, X, y, context):
+        if y is None:
+            return super()._score_context(X, y, context)
+        if context is not None:
+            raise self._both_error("y")
+        if not self._labelled:
+            raise self._unlabelled_error("y")
+        return self._as_context(self._style_weights(y, X.shape[0], "y"), X)
+
+    def _unlabelled_error(self, name):
+        return ValueError(
+            f"{type(self).__name__} was fitted on a real-valued context, not on "
+            f"labels: it has no styles to take {name} or to predict. Give "
+            "context=, or fit it with labels y."
+        )
+
+    def _style_context(self, style, n_frames, like):
+        if not self._labelled:
+            raise self._unlabelled_error("style=")
+        return self._as_context(self._style_weights(style, n_frames), like)
+
+    def _inference_context(self, X, sequences, context):
+        """The context given, or each sequence's posterior over the styles."""
+        if context is None and self._labelled:
+            return self._as_context(self._posterior(X, sequences), X)
+        return super()._inference_context(X, sequences, context)
+
+    def _frame_log_likelihoods(self, X, sequences, context):
+        """Given a context, the frames' log-likelihood; with the style unknown,
+        that of the mixture of the styles (:meth:`_mixture_log_likelihoods`)."""
+        if context is None and self._labelled:
+            return self._as_context(self._mixture_log_likelihoods(X, sequences), X)
+        return super()._frame_log_likelihoods(X, sequences, context)
+
+    def _online_context(self, X, context):
+        """What on-line fill-in conditions on: every frame's context, or hypotheses.
+
+        Returns ``(frame_context, hypotheses)``: the context given, or (a
+        model fitted on labels, given none) one one-hot hypothesis per style
+        for the chains of a particle filter to carry.
+        """
+        if context is None and self._labelled:
+            return None, self._as_context(np.eye(len(self.classes_)), X)
+        return super()._online_context(X, context)
+
     def _style_weights(self, style, n_frames, name="style"):
         """Label weights ``(n_frames, n_classes)`` of a label, labels or weights."""
         check_is_fitted(self)
@@ -187,12 +256,6 @@ class BaseStyleModel(BaseLayerModel):
     def _as_context(self, weights, like):
         ops = array_ops(like)
         return ops.asarray(weights, dtype=like.dtype)
-
-    def _style_context(self, X, sequences, style):
-        """The context of every frame: the style given, or the sequence's posterior."""
-        if style is None:
-            return self._as_context(self._posterior(X, sequences), X)
-        return self._as_context(self._style_weights(style, X.shape[0]), X)
 
     # ----------------------------------------------------------- inference
 
@@ -257,12 +320,6 @@ class BaseStyleModel(BaseLayerModel):
             posterior[rows] = np.exp(log_post - logsumexp(log_post))
         return posterior
 
-    def _frame_log_likelihoods(self, X, sequences, y=None, name="y"):
-        if y is not None:
-            context = self._as_context(self._style_weights(y, X.shape[0], name), X)
-            return self._log_likelihood(X, sequences, context=context).log_likelihood
-        return self._as_context(self._mixture_log_likelihoods(X, sequences), X)
-
     def _posterior_key(self, X, sequences):
         """A digest of everything :meth:`_posterior` depends on."""
         digest = hashlib.blake2b(digest_size=16)
@@ -323,6 +380,8 @@ class BaseStyleModel(BaseLayerModel):
 
     def _log_posterior(self, X, sequence_ids, method):
         X, sequences = self._check_inference_input(X, sequence_ids, method)
+        if not self._labelled:
+            raise self._unlabelled_error(method)
         with np.errstate(divide="ignore"):
             return self._as_context(np.log(self._posterior(X, sequences)), X)
 
@@ -366,245 +425,6 @@ class BaseStyleModel(BaseLayerModel):
         if styles.dtype.kind in "biuf":  # numbers go back to X's namespace
             return array_ops(log_proba).asarray(styles)
         return styles
-
-    @limit_blas_threads(frame_rows)
-    def transform(self, X, style=None, *, sequence_ids=None):
-        """Hidden probabilities of every frame, given its style.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        style : label, array-like of shape (n_frames,) or (n_frames, n_classes), \
-default=None
-            The style of every frame (see the class docstring); None: each
-            sequence's posterior over the styles (:meth:`predict_proba`) as
-            its label weights.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-
-        Returns
-        -------
-        H : ndarray of shape (n_frames, n_components)
-            ``p(h = 1 | x_t, past, style)``; a sequence's first frames use
-            its first frame as their missing past (edge padding).
-        """
-        X, sequences = self._check_inference_input(X, sequence_ids)
-        context = self._style_context(X, sequences, style)
-        return self._representations(X, sequences, self._layers(), context)[-1]
-
-    @limit_blas_threads(frame_rows)
-    def score_samples(self, X, style=None, *, sequence_ids=None):
-        """``log p(x_t | past, style)`` of every frame, in nats.
-
-        Exact for few hidden units, annealed otherwise (as
-        :meth:`ConditionalRBM.score_samples`).  With the style unknown
-        (``style=None``), the frame's log-likelihood under the mixture of
-        the styles, each weighted by its posterior given the sequence's
-        frames before it (from ``priors``): ``log sum_k p(k | x_<t) p(x_t |
-        past, k)``.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        style : label, array-like of shape (n_frames,) or (n_frames, \
-n_classes), default=None
-            Every frame's style; None: unknown (see above).
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-
-        Returns
-        -------
-        log_likelihood : ndarray of shape (n_frames,)
-        """
-        X, sequences = self._check_inference_input(X, sequence_ids, "score_samples")
-        log_likelihood = self._frame_log_likelihoods(X, sequences, style, "style")
-        return array_ops(X).astype(log_likelihood, X.dtype)
-
-    @limit_blas_threads(frame_rows)
-    def estimate_log_likelihood(
-        self,
-        X,
-        style,
-        *,
-        sequence_ids=None,
-        method="auto",
-        reverse=True,
-        random_state=None,
-    ):
-        """``log p(x_t | past, style)`` of every frame, with how far to trust it.
-
-        As :meth:`ConditionalRBM.estimate_log_likelihood`, given the style.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        style : label, array-like of shape (n_frames,) or (n_frames, n_classes)
-            Every frame's style.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-        method : {"auto", "exact", "ais"}, default="auto"
-        reverse : bool, default=True
-            Also run reverse annealing (a conservative estimate).
-        random_state : int, RandomState instance or None, default=None
-            Seeds the annealing; None uses the estimator's ``random_state``.
-
-        Returns
-        -------
-        result : :class:`~sklearn.utils.Bunch`
-            ``log_likelihood``, ``lower``, ``standard_error`` and ``method``,
-            as :meth:`ConditionalRBM.estimate_log_likelihood` gives them.
-        """
-        X, sequences = self._check_inference_input(
-            X, sequence_ids, "estimate_log_likelihood"
-        )
-        context = self._as_context(self._style_weights(style, X.shape[0]), X)
-        return self._estimate(X, sequences, context, method, reverse, random_state)
-
-    def fit_transform(self, X, y=None, *, sequence_ids=None):
-        """Fit, then return the hidden probabilities of ``X`` given ``y``.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-            All sequences stacked, each contiguous and in time order.
-        y : array-like of shape (n_frames,) or (n_frames, n_classes)
-            The style of every frame.
-        sequence_ids : array-like of shape (n_frames,), default=None
-            Integer sequence id of every frame; ``None`` means one sequence.
-
-        Returns
-        -------
-        H : ndarray of shape (n_frames, n_components)
-        """
-        return self.fit(X, y, sequence_ids=sequence_ids).transform(
-            X, y, sequence_ids=sequence_ids
-        )
-
-    @limit_blas_threads(frame_rows)
-    def predict_next(self, X, style=None, *, sequence_ids=None):
-        """One-step-ahead prediction of every frame from its past and its style.
-
-        Mean field from the frame's directed prediction, as
-        :meth:`ConditionalRBM.predict_next`; ``style`` as in
-        :meth:`transform`.
-
-        Parameters
-        ----------
-        X : array-like of shape (n_frames, n_features)
-        style : label, array-like, default=None
-        sequence_ids : array-like of shape (n_frames,), default=None
-
-        Returns
-        -------
-        X_pred : ndarray of shape (n_frames, n_features)
-        """
-        X, sequences = self._check_inference_input(X, sequence_ids, "predict_next")
-        context = self._style_context(X, sequences, style)
-        return self._predict_frames(X, sequences, context=context)
-
-    def _online_context(self, X, style):
-        """What on-line fill-in conditions on: every frame's context, or hypotheses.
-
-        Returns ``(frame_context, hypotheses)``: the given style as every
-        frame's label weights, or (style None) one one-hot hypothesis per
-        style for the chains of a particle filter to carry.
-        """
-        if style is not None:
-            return self._as_context(self._style_weights(style, X.shape[0]), X), None
-        return None, self._as_context(np.eye(len(self.classes_)), X)
-
-    # ----------------------------------------------------------- generation
-
-    @limit_blas_threads(sequence_rows)
-    def sample(
-        self,
-        n_frames,
-        *,
-        history=None,
-        style,
-        n_sequences=1,
-        n_gibbs=None,
-        hidden_noise=0.0,
-        random_state=None,
-        n_jobs=None,
-    ):
-        """Generate new frames in a given style, blend of styles or transition.
-
-        Each new frame starts from the previous frame plus noise, ``n_gibbs``
-        alternating Gibbs iterations follow (hidden units sampled, visibles
-        set to their mean) and a final mean-field step, the layer
-        conditioned on the frame's label weights.
-
-        Parameters
-        ----------
-        n_frames : int
-            Number of new frames per sequence.
-        history : array-like, default=None
-            Seed frames, oldest first, at least ``history_length`` of them:
-            shape ``(n_frames_seed, n_features)`` for every sequence, or
-            ``(n_sequences, n_frames_seed, n_features)``.  ``None`` draws
-            windows of training frames kept by :meth:`fit`.
-        style : label or array-like of shape (n_frames, n_classes)
-            The style of every new frame: a label seen in :meth:`fit`, or
-            non-negative label weights that sum to 1 in every frame (a
-            blend; a transition when they change over the frames).
-        n_sequences : int, default=1
-            Number of sequences, generated together.
-        n_gibbs : int, default=None
-            Alternating Gibbs iterations per frame; None: the model's
-            ``n_gibbs``.
-        hidden_noise : float, default=0.0
-            Standard deviation of noise added to the hidden biases each time
-            hidden states are drawn.
-        random_state : int, RandomState instance or None, default=None
-            Seeds the generation; None uses the estimator's ``random_state``.
-        n_jobs : int, default=None
-            Jobs generating blocks of sequences in parallel; the frames do
-            not depend on it.
-
-        Returns
-        -------
-        X_new : ndarray of shape (n_sequences * n_frames, n_features)
-            The generated frames, sequence after sequence.
-        """
-        check_is_fitted(self)
-        n_frames = check_count(n_frames, "n_frames", minimum=1)
-        n_sequences = check_count(n_sequences, "n_sequences", minimum=1)
-        n_gibbs = self.n_gibbs if n_gibbs is None else n_gibbs
-        n_gibbs = check_count(n_gibbs, "n_gibbs", minimum=0)
-        if not isinstance(hidden_noise, Real) or not hidden_noise >= 0:
-            raise ValueError(
-                f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
-            )
-        weights = self._style_weights(style, n_frames)
-        rng = rng_from(self.random_state if random_state is None else random_state)
-        seed = seed_frames(
-            history,
-            n_sequences,
-            width=max(self.history_length, 1),
-            n_features=self.n_features_in_,
-            dtype=self._layers()[0].dtype,
-            seed_windows=self.seed_windows_,
-            rng=rng,
-        )
-        ops = array_ops(seed)
-        context = self._as_context(weights, seed)
-        context = ops.broadcast_to(context[None, ...], (seed.shape[0], *weights.shape))
-        frames = self._generate(
-            seed,
-            n_frames,
-            rng,
-            context=context,
-            n_jobs=n_jobs,
-            n_gibbs=n_gibbs,
-            hidden_noise=hidden_noise,
-            sample_visibles=False,
-        )
-        self._check_generated(frames, n_frames)
-        return frames
 
     def __sklearn_array_api_convert__(self, converter):
         """A copy on another namespace or device whose labels stay on the host.

@@ -2,8 +2,8 @@
 
 :func:`train_epochs` runs the loop every estimator shares: minibatches
 gathered by index arithmetic, noise on their histories, the layer's own
-CD statistics (:meth:`~sklearn_crbm._layer.ConditionalLayer.cd_statistics`),
-momentum and weight decay (:class:`~sklearn_crbm._parameters.MomentumUpdate`),
+CD statistics (:meth:`~sklearn_crbm.layers.ConditionalLayer.cd_statistics`),
+momentum and weight decay (:class:`~sklearn_crbm.layers._parameters.MomentumUpdate`),
 parameter averaging, and a check for divergence after every epoch.
 :class:`ProgressMonitor` reports what ``verbose`` asks for.
 """
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._gibbs import mean_field_prediction
-from ._parameters import MomentumUpdate, ParameterAverage
+from .layers._parameters import MomentumUpdate, ParameterAverage
 from .utils._array_api import array_ops, array_random, to_device_batches
 from .utils._random import add_history_noise, rng_from
 from .utils._sequences import balanced_batches, frame_history, shuffled_batches
@@ -144,7 +144,7 @@ class ProgressMonitor:
 class StepBound:
     """Each weight matrix's step per minibatch, at most ``max_step`` times its norm.
 
-    Wraps a :class:`~sklearn_crbm._parameters.MomentumUpdate`: after its
+    Wraps a :class:`~sklearn_crbm.layers._parameters.MomentumUpdate`: after its
     step, the velocity of every decayed group (every weight matrix; not the
     biases) whose norm exceeds ``max_step`` times the matrix's norm before
     the step is scaled down to it, and the step with it.  The velocity

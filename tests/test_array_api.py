@@ -36,11 +36,11 @@ from sklearn_crbm import (
     NearestNeighborImputer,
     StackedCRBM,
 )
-from sklearn_crbm._crbm_layer import CRBMLayer
 from sklearn_crbm._gibbs import gibbs_frames
 from sklearn_crbm._online import History, _ancestors
-from sklearn_crbm._parameters import MomentumUpdate
 from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.layers._crbm import CRBMLayer
+from sklearn_crbm.layers._parameters import MomentumUpdate
 from sklearn_crbm.utils._array_api import ArrayRandom, array_ops
 
 
@@ -136,8 +136,8 @@ def _is_style_model(model):
 
 
 def _given(model, ids):
-    """The frames' styles as a method's second argument; none for other models."""
-    return (_styles(ids),) if _is_style_model(model) else ()
+    """The frames' styles as ``style=``; none for other models."""
+    return {"style": _styles(ids)} if _is_style_model(model) else {}
 
 
 def _one_style(model):
@@ -316,22 +316,22 @@ def test_pickling_keeps_the_namespace_and_moving_to_numpy_keeps_the_model(
     X_xp = _to(xp, device, X)
     model = _small_model(estimator)
     given = _given(model, ids)
-    model.fit(X_xp, *given, sequence_ids=ids)
-    expected = _numpy(model.transform(X_xp, *given, sequence_ids=ids))
+    model.fit(X_xp, given.get("style"), sequence_ids=ids)
+    expected = _numpy(model.transform(X_xp, **given, sequence_ids=ids))
     loaded = pickle.loads(pickle.dumps(model))
     _same_place(loaded._layers()[0].flat, X_xp)
     np.testing.assert_array_equal(
-        _numpy(loaded.transform(X_xp, *given, sequence_ids=ids)), expected
+        _numpy(loaded.transform(X_xp, **given, sequence_ids=ids)), expected
     )
     on_numpy = pickle.loads(pickle.dumps(move_estimator_to(model, np, None)))
     with sklearn.config_context(array_api_dispatch=False):
         np.testing.assert_allclose(
-            on_numpy.transform(X, *given, sequence_ids=ids),
+            on_numpy.transform(X, **given, sequence_ids=ids),
             expected,
             rtol=1e-5,
             atol=1e-6,
         )
-        on_numpy.partial_fit(X, *given, sequence_ids=ids)  # and trains on
+        on_numpy.partial_fit(X, given.get("style"), sequence_ids=ids)  # and trains on
     assert isinstance(on_numpy._layers()[0].flat, np.ndarray)
 
 
@@ -345,11 +345,11 @@ def test_input_of_another_namespace_is_a_clear_error(
     with sklearn.config_context(array_api_dispatch=True):
         model = _small_model(estimator)
         given = _given(model, ids)
-        model.fit(_to(xp, device, X), *given, sequence_ids=ids)
+        model.fit(_to(xp, device, X), given.get("style"), sequence_ids=ids)
         with pytest.raises(ValueError, match="same namespace"):
-            model.transform(X, *given, sequence_ids=ids)
+            model.transform(X, **given, sequence_ids=ids)
     with pytest.raises(ValueError, match="array_api_dispatch=True"):
-        model.score(X, *given, sequence_ids=ids)
+        model.score(X, given.get("style"), sequence_ids=ids)
 
 
 @pytest.mark.parametrize("namespace, device_name, dtype_name", COMBINATIONS)
@@ -373,7 +373,7 @@ def test_style_models_fit_and_run_on_the_input_device_as_on_numpy(
     ):
         _same_place(output, X_xp)
     # the likelihood's estimate is float64 in any case, as ConditionalRBM's
-    estimate = model.estimate_log_likelihood(X_xp, styles, sequence_ids=ids)
+    estimate = model.estimate_log_likelihood(X_xp, style=styles, sequence_ids=ids)
     xp_out, _, device_out = get_namespace_and_device(estimate.log_likelihood)
     assert (xp_out, device_out) == get_namespace_and_device(X_xp)[::2]
     # A model fitted on numpy, moved over, computes what it computes on numpy;
@@ -385,12 +385,12 @@ def test_style_models_fit_and_run_on_the_input_device_as_on_numpy(
     rtol = 1e-4 if dtype_name == "float32" else 1e-10
     # style given, and unknown (each sequence's posterior, or the mixture)
     for method, given in itertools.product(
-        ["transform", "predict_next", "score_samples"], [(styles,), ()]
+        ["transform", "predict_next", "score_samples"], [{"style": styles}, {}]
     ):
-        got = getattr(moved, method)(X_xp, *given, sequence_ids=ids)
+        got = getattr(moved, method)(X_xp, **given, sequence_ids=ids)
         _same_place(got, X_xp)
         with sklearn.config_context(array_api_dispatch=False):
-            expected = getattr(reference, method)(X, *given, sequence_ids=ids)
+            expected = getattr(reference, method)(X, **given, sequence_ids=ids)
         np.testing.assert_allclose(_numpy(got), expected, rtol=rtol, atol=rtol)
     proba = moved.predict_proba(X_xp, sequence_ids=ids)
     _same_place(proba, X_xp)
@@ -401,6 +401,53 @@ def test_style_models_fit_and_run_on_the_input_device_as_on_numpy(
     np.testing.assert_array_equal(
         moved.predict(X_xp, sequence_ids=ids), expected_styles
     )
+
+
+def _context(ids, dtype_name):
+    """A control signal per frame: the sequence's sign, and a ramp."""
+    ramp = np.linspace(-1, 1, len(ids))
+    sign = np.where(ids % 2 == 1, 1.0, -1.0)
+    return np.column_stack([sign, ramp]).astype(dtype_name or "float64")
+
+
+@pytest.mark.parametrize("namespace, device_name, dtype_name", COMBINATIONS)
+def test_a_model_of_a_context_runs_on_the_input_device_as_on_numpy(
+    namespace, device_name, dtype_name, dispatch
+):
+    xp, device = _array_api_for_tests(namespace, device_name, dtype_name)
+    X, ids = _data(dtype_name)
+    context = _context(ids, dtype_name)
+    X_xp, context_xp = _to(xp, device, X), _to(xp, device, context)
+    model = _small_model("crbm").fit(X_xp, sequence_ids=ids, context=context_xp)
+    model.partial_fit(X_xp, sequence_ids=ids, context=context_xp)
+    assert model.n_iter_ == 3 and model.n_context_ == 2
+    _same_place(model._layers()[0].flat, X_xp)
+    for output in (
+        model.sample(4, context=context_xp[:1, ...], n_sequences=3, random_state=0),
+        model.sample(4, context=context[:4], history=X_xp[:2, ...], random_state=0),
+    ):
+        _same_place(output, X_xp)
+    X_missing = X[ids == 3].copy()
+    X_missing[10:, :2] = np.nan
+    imputer = CRBMImputer(model, n_particles=2, random_state=0)
+    imputer.fit(X_xp, sequence_ids=ids, context=context_xp)
+    filled = imputer.transform(
+        _to(xp, device, X_missing), context=_to(xp, device, context[ids == 3])
+    )
+    _same_place(filled, X_xp)
+    # fitted on numpy and moved over, it computes what it computes on numpy
+    with sklearn.config_context(array_api_dispatch=False):
+        reference = _small_model("crbm", n_iter=5).fit(
+            X, sequence_ids=ids, context=context
+        )
+    moved = move_estimator_to(reference, xp, device)
+    rtol = 1e-4 if dtype_name == "float32" else 1e-10
+    for method in ["transform", "predict_next", "score_samples"]:
+        got = getattr(moved, method)(X_xp, sequence_ids=ids, context=context_xp)
+        _same_place(got, X_xp)
+        with sklearn.config_context(array_api_dispatch=False):
+            expected = getattr(reference, method)(X, sequence_ids=ids, context=context)
+        np.testing.assert_allclose(_numpy(got), expected, rtol=rtol, atol=rtol)
 
 
 def _imputer_data(dtype_name):
@@ -767,14 +814,14 @@ def test_every_path_runs_at_the_default_size(
     X_xp = _to(xp, device, X)
     model = _default_model(estimator)
     given, style = _given(model, ids), _one_style(model)
-    model.fit(X_xp, *given, sequence_ids=ids)
-    model.partial_fit(X_xp, *given, sequence_ids=ids)
+    model.fit(X_xp, given.get("style"), sequence_ids=ids)
+    model.partial_fit(X_xp, given.get("style"), sequence_ids=ids)
     n_frames, n_features = X.shape
     sizes = DEFAULT_SIZES[estimator]
     outputs = {
-        "transform": model.transform(X_xp, *given, sequence_ids=ids),
-        "predict_next": model.predict_next(X_xp, *given, sequence_ids=ids),
-        "score_samples": model.score_samples(X_xp, *given, sequence_ids=ids),
+        "transform": model.transform(X_xp, **given, sequence_ids=ids),
+        "predict_next": model.predict_next(X_xp, **given, sequence_ids=ids),
+        "score_samples": model.score_samples(X_xp, **given, sequence_ids=ids),
         "sample one": model.sample(4, random_state=0, **style),
         # 30 sequences: 6,000 hidden states per Gibbs step
         "sample many": model.sample(
@@ -800,7 +847,7 @@ def test_every_path_runs_at_the_default_size(
         for method in ("transform", "predict_next"):
             np.testing.assert_allclose(
                 _numpy(outputs[method]),
-                getattr(on_numpy, method)(X, *given, sequence_ids=ids),
+                getattr(on_numpy, method)(X, **given, sequence_ids=ids),
                 rtol=rtol,
                 atol=rtol,
             )
@@ -824,7 +871,7 @@ def test_crbm_imputer_fills_sequences_of_different_lengths_at_the_default_size(
     model = _default_model(estimator)
     imputer = CRBMImputer(model, n_gibbs=3, random_state=0)
     assert imputer.n_particles == 20 and imputer.n_draws == 1  # the defaults
-    imputer.fit(_to(xp, device, X), *_given(model, ids), sequence_ids=ids)
+    imputer.fit(_to(xp, device, X), _given(model, ids).get("style"), sequence_ids=ids)
     X_xp = _to(xp, device, X_missing)
     # a model of styles infers the style in transform and is given it in sample
     outputs = {

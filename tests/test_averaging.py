@@ -14,9 +14,9 @@ from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.utils._param_validation import InvalidParameterError
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_layer import CRBMLayer
-from sklearn_crbm._parameters import ParameterAverage
 from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.layers._crbm import CRBMLayer
+from sklearn_crbm.layers._parameters import ParameterAverage
 
 GROUPS = (
     "components_",

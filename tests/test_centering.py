@@ -16,8 +16,8 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.special import expit
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_layer import CRBMLayer, shift_centred
 from sklearn_crbm.datasets import load_cmu35, make_oscillations
+from sklearn_crbm.layers._crbm import CRBMLayer, shift_centred
 from sklearn_crbm.preprocessing import make_motion_preprocessor
 
 N_FEATURES, N_COMPONENTS, ORDER = 3, 4, 2

@@ -14,8 +14,9 @@ import sklearn
 from numpy.testing import assert_array_equal
 from PIL import Image
 
-from sklearn_crbm import _cli, _cli_options, _style_demo
-from sklearn_crbm._cli import main
+from sklearn_crbm.cli import _main as _cli
+from sklearn_crbm.cli import _options as _cli_options
+from sklearn_crbm.cli import _style_demo, main
 from sklearn_crbm.datasets import (
     bone_columns,
     load_bandai_walks,

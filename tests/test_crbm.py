@@ -24,8 +24,8 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
 from sklearn_crbm import ConditionalRBM, TrainingDivergedError
-from sklearn_crbm._crbm_layer import CRBMFrames
 from sklearn_crbm.datasets import load_cmu35, make_oscillations
+from sklearn_crbm.layers._crbm import CRBMFrames
 from sklearn_crbm.model_selection import make_prediction_scorer
 from sklearn_crbm.utils._random import rng_from, standard_normal, uniform
 from sklearn_crbm.utils._sequences import balanced_batches, frame_history
@@ -553,7 +553,7 @@ def test_binary_visibles():
     hidden_bias = layer.hidden_bias + X[:-1] @ model.past_to_hidden_[0].T
     visible_bias = np.zeros((len(X) - 1, layer.n_features))  # unused by p(h | v)
     rbms = CRBMFrames(
-        visible_bias, hidden_bias, layer.visible_std, layer.binary, layer.weights
+        visible_bias, hidden_bias, layer.visible_std, layer.visible_units, layer.weights
     )
     H = rbms.hidden_probabilities(X[1:])
     assert_allclose(model.transform(X)[1:], H, rtol=1e-12)

@@ -13,10 +13,10 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from scipy.special import expit
 
-from sklearn_crbm._crbm_layer import CRBMFrames, CRBMLayer
 from sklearn_crbm._gibbs import HiddenSampler, gibbs_frames
-from sklearn_crbm._layer import logistic
-from sklearn_crbm._parameters import MomentumUpdate
+from sklearn_crbm.layers._base import logistic
+from sklearn_crbm.layers._crbm import CRBMFrames, CRBMLayer
+from sklearn_crbm.layers._parameters import MomentumUpdate
 from sklearn_crbm.utils._random import uniform
 
 
@@ -40,7 +40,9 @@ def frames_of(params, hidden_bias, visible_bias=None):
     """The frame RBMs of ``params`` with the given dynamic biases."""
     if visible_bias is None:
         visible_bias = np.zeros((len(hidden_bias), params.n_features), params.dtype)
-    return CRBMFrames(visible_bias, hidden_bias, None, False, params.weights)
+    return CRBMFrames(
+        visible_bias, hidden_bias, None, params.visible_units, params.weights
+    )
 
 
 def cd(params, visible, history, cd_steps, rng, *, out=None, scale=1.0, workspace=None):

@@ -44,8 +44,8 @@ def test_fit_learns_the_styles(fitted):
     assert fitted.n_iter_ == 400 and fitted._layer.is_finite()
     X, ids, styles = styled_data(random_state=1)
     flipped = np.where(styles == "low", "high", "low")
-    right = fitted.predict_next(X, styles, sequence_ids=ids)
-    wrong = fitted.predict_next(X, flipped, sequence_ids=ids)
+    right = fitted.predict_next(X, style=styles, sequence_ids=ids)
+    wrong = fitted.predict_next(X, style=flipped, sequence_ids=ids)
     assert np.mean((X - right)[:, 0] ** 2) < 0.25 * np.mean((X - wrong)[:, 0] ** 2)
     assert fitted.score(X, styles, sequence_ids=ids) > fitted.score(
         X, flipped, sequence_ids=ids
@@ -114,10 +114,10 @@ def test_score_samples_is_exact_for_a_tiny_model():
     layer.flat[...] = 0.5 * rng.standard_normal(layer.flat.shape)
     weights = rng.dirichlet([1, 1], size=len(X))  # blends, frame by frame
     expected = exact_log_likelihood(model, X, ids, weights)
-    assert_allclose(model.score_samples(X, weights, sequence_ids=ids), expected)
+    assert_allclose(model.score_samples(X, style=weights, sequence_ids=ids), expected)
     one_hot = np.eye(2)[np.searchsorted(model.classes_, styles)]
     assert_allclose(
-        model.score_samples(X, styles, sequence_ids=ids),
+        model.score_samples(X, style=styles, sequence_ids=ids),
         exact_log_likelihood(model, X, ids, one_hot),
     )
     # annealing agrees with enumeration to within its error
@@ -228,7 +228,7 @@ def test_partial_fit_and_float32(fitted):
 
 def test_start_values_are_the_released_codes():
     """Every weight from 0.01 N(0, 1) in the order of the groups (R too), biases 0."""
-    from sklearn_crbm._factored_layer import FactoredLayer
+    from sklearn_crbm.layers._factored import FactoredLayer
 
     layer = FactoredLayer(5, 7, 4, 3, 2, 2, np.float64).initialize(
         np.random.default_rng(0)
@@ -246,8 +246,8 @@ def test_start_values_are_the_released_codes():
 def test_learning_rates_per_group_and_momentum_are_the_released_codes():
     """A tenth of the rate for past->visible factors and R; the rest in full,
     past->hidden and style->factor weights included; momentum 0.9 from epoch 6."""
-    from sklearn_crbm._factored_layer import FactoredLayer
     from sklearn_crbm._training import Schedule
+    from sklearn_crbm.layers._factored import FactoredLayer
 
     for shared in (True, False):
         layer = FactoredLayer(5, 7, 4, 3, 2, 2, np.float64, shared_style_weights=shared)
@@ -261,9 +261,9 @@ def test_learning_rates_per_group_and_momentum_are_the_released_codes():
 
 def _bounded_update(max_step, statistics):
     """One momentum step of a small layer, bounded; ``(before, after, update)``."""
-    from sklearn_crbm._factored_layer import FactoredLayer
-    from sklearn_crbm._parameters import MomentumUpdate
     from sklearn_crbm._training import StepBound
+    from sklearn_crbm.layers._factored import FactoredLayer
+    from sklearn_crbm.layers._parameters import MomentumUpdate
 
     layer = FactoredLayer(5, 7, 4, 3, 2, 2, np.float64)
     layer.initialize(np.random.default_rng(0))
@@ -336,7 +336,7 @@ def test_divergence_says_what_to_change():
 @pytest.mark.parametrize("ramp", [5, 0])
 def test_momentum_rises_over_the_ramp_after_the_delay(monkeypatch, ramp):
     from sklearn_crbm import ConditionalRBM
-    from sklearn_crbm._parameters import MomentumUpdate
+    from sklearn_crbm.layers._parameters import MomentumUpdate
 
     seen = []
     apply = MomentumUpdate.apply
@@ -395,8 +395,8 @@ def test_cd_statistics_are_the_gradient_of_the_free_energy_difference(
 ):
     """With probabilities for states, CD-1's statistics are the gradient of
     ``-F(v) + F(v_recon)`` (the reconstruction held fixed)."""
-    from sklearn_crbm import _factored_layer
-    from sklearn_crbm._factored_layer import FactoredLayer
+    from sklearn_crbm.layers import _factored as _factored_layer
+    from sklearn_crbm.layers._factored import FactoredLayer
 
     monkeypatch.setattr(_factored_layer, "HiddenSampler", _MeanField)
     rng = np.random.default_rng(0)

@@ -53,15 +53,15 @@ def test_score_samples_is_exact_for_a_tiny_model():
         start = np.flatnonzero(ids == ids[t])[0]
         past = X[max(t - 1, start)]
         c_hat = layer.visible_bias + layer.dynamic[:d] @ past
-        c_hat = c_hat + layer.label_weights[:d] @ weights[t]
+        c_hat = c_hat + layer.context_weights[:d] @ weights[t]
         b_hat = layer.hidden_bias + layer.dynamic[d:] @ past
-        b_hat = b_hat + layer.label_weights[d:] @ weights[t]
+        b_hat = b_hat + layer.context_weights[d:] @ weights[t]
         u = states @ layer.weights
         joint = -0.5 * np.sum((X[t] - c_hat - u) ** 2, axis=1) + states @ b_hat
         joint += u @ c_hat + 0.5 * np.sum(u**2, axis=1)
         log_z = logsumexp(states @ b_hat + u @ c_hat + 0.5 * np.sum(u**2, axis=1))
         expected.append(logsumexp(joint) - log_z - 0.5 * d * np.log(2 * np.pi))
-    got = model.score_samples(X, weights, sequence_ids=ids)
+    got = model.score_samples(X, style=weights, sequence_ids=ids)
     assert_allclose(got, expected, rtol=1e-9, atol=1e-9)
 
 

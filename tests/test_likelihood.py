@@ -15,13 +15,14 @@ from numpy.testing import assert_allclose
 from scipy.special import logsumexp
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_layer import CRBMFrames
 from sklearn_crbm._likelihood import (
     annealing_schedule,
     exact_is_cheaper,
     log_partition_ais,
     log_partition_exact,
 )
+from sklearn_crbm.layers._base import GaussianUnits
+from sklearn_crbm.layers._crbm import CRBMFrames
 
 
 def random_model(
@@ -202,7 +203,7 @@ def test_ais_is_unbiased_for_the_partition_function():
     weights = rng.standard_normal((8, 4))
     visible_bias, hidden_bias = rng.standard_normal((3, 4)), rng.standard_normal((3, 8))
     std = np.array([0.5, 1, 1, 2])
-    rbms = CRBMFrames(visible_bias, hidden_bias, std, False, weights)
+    rbms = CRBMFrames(visible_bias, hidden_bias, std, GaussianUnits(), weights)
     log_z, error = log_partition_ais(rbms, 200, 2000, np.random.default_rng(1))
     assert_allclose(log_z, log_partition_exact(rbms), atol=max(0.01, 4 * error.max()))
 

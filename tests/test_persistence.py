@@ -60,6 +60,10 @@ STORED_OUTPUTS = DATA / f"pickle_format{PICKLE_FORMAT}_outputs.json"
 
 X_OSC, IDS_OSC = make_oscillations(n_sequences=4, n_frames=40, random_state=0)
 WALKER = make_walker(n_sequences=2, n_frames=40, random_state=0)
+# a control signal per frame: the sequence's sign and a ramp
+C_OSC = np.column_stack(
+    [np.where(IDS_OSC % 2 == 0, 1.0, -1.0), np.linspace(-1, 1, len(X_OSC))]
+)
 X_MISSING = X_OSC[IDS_OSC == 3].copy()
 X_MISSING[20:, :2] = np.nan
 X_STY, IDS_STY, STY = make_styled_oscillations(
@@ -87,6 +91,12 @@ ROUND_TRIPS = [_pickle, _joblib]
 def _crbm():
     return ConditionalRBM(n_components=8, order=2, n_iter=5, random_state=0).fit(
         X_OSC, sequence_ids=IDS_OSC
+    )
+
+
+def _crbm_context():
+    return ConditionalRBM(n_components=8, order=2, n_iter=5, random_state=0).fit(
+        X_OSC, sequence_ids=IDS_OSC, context=C_OSC
     )
 
 
@@ -143,6 +153,14 @@ def _crbm_imputer():
     )
 
 
+def _context_imputer():
+    model = ConditionalRBM(n_components=8, order=2, n_iter=5, random_state=0)
+    train = IDS_OSC < 3
+    return CRBMImputer(model, n_gibbs=5, random_state=0).fit(
+        X_OSC[train], sequence_ids=IDS_OSC[train], context=C_OSC[train]
+    )
+
+
 def _style_imputer():
     return CRBMImputer(_small_factored(), n_gibbs=3, n_particles=4, random_state=0).fit(
         X_STY, STY, sequence_ids=IDS_STY
@@ -153,13 +171,14 @@ def _nn_imputer():
     return NearestNeighborImputer().fit(X_OSC[IDS_OSC < 3])
 
 
-def _model_outputs(model, X, ids, styles=None):
-    """What a fitted model computes on ``X``; a style model given ``styles``.
+def _model_outputs(model, X, ids, styles=None, context=None):
+    """What a fitted model computes on ``X``; a style model given ``styles``,
+    a model of a context given ``context``.
 
-    Every method takes the styles of the frames second, as the style
-    models define them; generation takes the first and the last style.
+    Every method takes the styles of the frames (``score`` as ``y``);
+    generation takes the first and the last style (or row of context).
     """
-    given = () if styles is None else (styles,)
+    given = {} if styles is None else {"style": styles}
     first, last = (
         ({}, {})
         if styles is None
@@ -168,11 +187,16 @@ def _model_outputs(model, X, ids, styles=None):
             {"style": model.classes_[-1]},
         )
     )
+    if context is not None:
+        given = {"context": context}
+        first, last = {"context": context[:1]}, {"context": context[-1:]}
     outputs = [
-        model.transform(X, *given, sequence_ids=ids),
-        model.predict_next(X, *given, sequence_ids=ids),
-        model.score_samples(X, *given, sequence_ids=ids),
-        np.atleast_1d(model.score(X, *given, sequence_ids=ids)),
+        model.transform(X, sequence_ids=ids, **given),
+        model.predict_next(X, sequence_ids=ids, **given),
+        model.score_samples(X, sequence_ids=ids, **given),
+        np.atleast_1d(
+            model.score(X, styles, sequence_ids=ids, context=given.get("context"))
+        ),
         model.sample(10, n_sequences=3, random_state=0, **first),
         model.sample(10, n_sequences=3, **last),  # the model's own random_state
     ]
@@ -190,6 +214,8 @@ def _outputs(estimator):
             estimator.transform(X_STY_MISSING, style="high"),
             estimator.transform(X_STY_MISSING),  # the style inferred
         ]
+    if isinstance(estimator, CRBMImputer) and estimator.estimator_.n_context_:
+        return [estimator.transform(X_MISSING, context=C_OSC[IDS_OSC == 3])]
     if isinstance(estimator, (CRBMImputer, NearestNeighborImputer)):
         return [estimator.transform(X_MISSING)]
     if isinstance(estimator, (ExpMapEncoder, StandardScaler)):
@@ -201,11 +227,14 @@ def _outputs(estimator):
         return [Z, estimator.inverse_transform(Z, sequence_ids=WALKER.sequence_ids)]
     if isinstance(estimator, STYLE_MODELS):
         return _model_outputs(estimator, X_STY, IDS_STY, STY)
+    if estimator.n_context_:
+        return _model_outputs(estimator, X_OSC, IDS_OSC, context=C_OSC)
     return _model_outputs(estimator, X_OSC, IDS_OSC)
 
 
 FITTED = [
     _crbm,
+    _crbm_context,
     _stack,
     _factored,
     _labelled,
@@ -213,6 +242,7 @@ FITTED = [
     _root,
     _scaler,
     _crbm_imputer,
+    _context_imputer,
     _style_imputer,
     _nn_imputer,
 ]

@@ -11,7 +11,7 @@ from sklearn.exceptions import NotFittedError
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
-from sklearn_crbm import ConditionalRBM
+from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM
 from sklearn_crbm import _base as base_module
 from sklearn_crbm._stacked import StackedCRBM
 from sklearn_crbm.datasets import make_oscillations
@@ -344,3 +344,28 @@ def test_a_failed_fit_leaves_the_stack_unfitted():
         stack.transform(X)
     with pytest.raises(NotFittedError, match="not fitted"):
         stack.sample(3)
+
+
+def test_it_stacks_any_layer_model():
+    """Layers of another kind: clones of ``estimator``, labels and context
+    passed up, the history the sum of the layers' pasts."""
+    X, ids = make_oscillations(n_sequences=4, n_frames=50, random_state=0)
+    labels = np.where(ids % 2 == 0, "a", "b")
+    stack = StackedCRBM(
+        (6, 4), estimator=LabelledCRBM(order=1, n_iter=3), random_state=0
+    ).fit(X, labels, sequence_ids=ids)
+    assert [type(m) for m in stack.layers_] == [LabelledCRBM, LabelledCRBM]
+    assert [m.n_components for m in stack.layers_] == [6, 4]
+    assert stack.history_length == 2 and stack.n_context_ == 2
+    weights = np.eye(2)[ids % 2]
+    assert stack.transform(X, sequence_ids=ids, context=weights).shape == (200, 4)
+    # the top layer was trained on the bottom's hidden units and their labels
+    top = stack.layers_[1]
+    assert top.n_features_in_ == 6 and list(top.classes_) == ["a", "b"]
+    context = np.where(ids[:, None] % 2 == 0, 1.0, -1.0)
+    factored = FactoredCRBM(n_factors=3, n_style_features=2, order=2, n_iter=2)
+    stack = StackedCRBM((6, 4), estimator=factored, random_state=0)
+    stack.fit(X, sequence_ids=ids, context=context)
+    assert stack.history_length == 4
+    assert np.isfinite(stack.score(X, sequence_ids=ids, context=context))
+    assert stack.sample(5, context=context[:1], random_state=0).shape == (5, 6)

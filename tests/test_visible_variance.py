@@ -18,9 +18,9 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.special import expit, logsumexp
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._crbm_layer import CRBMFrames, CRBMLayer
-from sklearn_crbm._gibbs import HiddenSampler, sample_visible_states
+from sklearn_crbm._gibbs import HiddenSampler
 from sklearn_crbm.datasets import make_oscillations
+from sklearn_crbm.layers._crbm import CRBMFrames, CRBMLayer
 
 N_FEATURES, N_COMPONENTS, ORDER = 2, 3, 1
 HIDDEN = np.array(list(itertools.product([0, 1], repeat=N_COMPONENTS)), dtype=float)
@@ -61,7 +61,11 @@ def frame(params, seed=1):
 def frame_rbms(params, visible_bias, hidden_bias):
     """The RBMs of frames with the dynamic biases given (one row each)."""
     return CRBMFrames(
-        visible_bias, hidden_bias, params.visible_std, params.binary, params.weights
+        visible_bias,
+        hidden_bias,
+        params.visible_std,
+        params.visible_units,
+        params.weights,
     )
 
 
@@ -138,7 +142,7 @@ def test_samplers_follow_the_conditionals():
     probabilities = rbms.hidden_probabilities(visible)
     assert_array_equal(states, uniforms < probabilities)
     # visible draws: mean + s * standard normal
-    draws = sample_visible_states(rbms, means, np.random.default_rng(4))
+    draws = rbms.sample_visibles(means, np.random.default_rng(4))
     noise = np.random.default_rng(4).standard_normal((n, N_FEATURES))
     assert_allclose(draws, means + np.sqrt(params.visible_variance) * noise)
 

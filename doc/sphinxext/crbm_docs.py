@@ -46,6 +46,11 @@ API_SECTIONS = [
     ("sklearn_crbm.model_selection", "Model selection", None),
     ("sklearn_crbm.plotting", "Plotting", None),
     ("sklearn_crbm.utils", "Utilities", None),
+    (
+        "sklearn_crbm.layers",
+        "Conditional layers: the interface of a new model kind",
+        None,
+    ),
 ]
 
 API_HEADER = """\

@@ -7,9 +7,9 @@ from sklearn.base import _fit_context, clone
 from sklearn.frozen import FrozenEstimator
 from sklearn.utils import check_random_state, get_tags
 from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
-from sklearn.utils.validation import _num_samples, check_is_fitted
+from sklearn.utils.validation import _is_fitted, _num_samples, check_is_fitted
 
-from .._base import check_count
+from .._base import check_context, check_count
 from .._crbm import ConditionalRBM
 from .._online import WHOLE_STACK, Observed, collect_fills, run_online
 from ..utils._array_api import array_ops, array_random, copy_array
@@ -50,11 +50,16 @@ class CRBMImputer(BaseMotionImputer):
 
     Parameters
     ----------
-    estimator : ConditionalRBM or StackedCRBM, default=None
-        The model, cloned and trained by :meth:`fit`; a fitted model wrapped
-        in :class:`sklearn.frozen.FrozenEstimator` is used as it is.  ``None``
-        means ``ConditionalRBM()`` seeded from ``random_state``.  The visible
-        units have unit variance: standardise the data first.
+    estimator : estimator of the package, default=None
+        The model (:class:`~sklearn_crbm.ConditionalRBM`,
+        :class:`~sklearn_crbm.StackedCRBM`, a style model, or any model of
+        conditional layers), cloned and trained by :meth:`fit`; a fitted
+        model wrapped in :class:`sklearn.frozen.FrozenEstimator` is used as
+        it is.  ``None`` means ``ConditionalRBM()`` seeded from
+        ``random_state``.  The imputer runs the model's layers
+        (``conditional_layers()``) given each frame's context
+        (``fill_in_context``).  The visible units have unit variance:
+        standardise the data first.
     n_gibbs : int, default=30
         Alternating Gibbs iterations per frame.
     n_draws : int, default=1
@@ -94,7 +99,7 @@ class CRBMImputer(BaseMotionImputer):
 
     Attributes
     ----------
-    estimator_ : ConditionalRBM or StackedCRBM
+    estimator_ : estimator of the package
         The fitted clone of ``estimator``, or the model inside a
         ``FrozenEstimator`` (not a copy).
     mean_ : ndarray of shape (`n_features_in_`,)
@@ -170,7 +175,12 @@ class CRBMImputer(BaseMotionImputer):
 
     _fitted_attribute = "_packed_parameters"
 
-    __metadata_request__transform = {"sequence_ids": True, "style": True}
+    __metadata_request__fit = {"sequence_ids": True, "context": True}
+    __metadata_request__transform = {
+        "sequence_ids": True,
+        "context": True,
+        "style": True,
+    }
 
     def __init__(
         self,
@@ -200,7 +210,7 @@ class CRBMImputer(BaseMotionImputer):
         self.verbose = verbose
 
     @_fit_context(prefer_skip_nested_validation=False)
-    def fit(self, X, y=None, *, sequence_ids=None):
+    def fit(self, X, y=None, *, sequence_ids=None, context=None):
         """Train the model on complete sequences.
 
         Parameters
@@ -215,6 +225,10 @@ class CRBMImputer(BaseMotionImputer):
             by a model without styles.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's real-valued context, for the model to train on
+            (see :meth:`ConditionalRBM.fit`); :meth:`transform` then needs
+            the context of the frames it fills.
 
         Returns
         -------
@@ -228,18 +242,22 @@ class CRBMImputer(BaseMotionImputer):
             estimator = self.estimator
             if estimator is None:
                 estimator = _default_model(self.random_state)
-            styles = _complete_styles(estimator, y, rows, n_frames)
+            styles = _complete_styles(estimator, y, rows, n_frames, context)
+            if context is not None:
+                context = _complete_rows(context, rows, n_frames, X)
             if isinstance(estimator, FrozenEstimator):
                 self.estimator_ = _check_frozen(estimator.estimator, X)
             else:
-                self.estimator_ = self._train(clone(estimator), X, run_ids, styles)
+                self.estimator_ = self._train(
+                    clone(estimator), X, run_ids, styles, context
+                )
             self.mean_ = ops.mean(X, axis=0)
             self.residual_variance_ = _residual_variance(
-                self.estimator_, X, run_ids, styles
+                self.estimator_, X, run_ids, styles, context
             )
         return self
 
-    def _train(self, estimator, X, sequence_ids, styles):
+    def _train(self, estimator, X, sequence_ids, styles, context):
         if self.verbose:
             if estimator.get_params().get("verbose", 1) == 0:
                 estimator.set_params(verbose=self.verbose)
@@ -247,10 +265,12 @@ class CRBMImputer(BaseMotionImputer):
                 f"[{type(self).__name__}] training {estimator!r} on {len(X)} "
                 f"complete frames in {len(np.unique(sequence_ids))} sequences"
             )
-        return estimator.fit(X, styles, sequence_ids=sequence_ids)
+        if context is None:  # a model that takes no context is not given one
+            return estimator.fit(X, styles, sequence_ids=sequence_ids)
+        return estimator.fit(X, styles, sequence_ids=sequence_ids, context=context)
 
     @limit_blas_threads(chain_rows)
-    def transform(self, X, *, sequence_ids=None, style=None):
+    def transform(self, X, *, sequence_ids=None, context=None, style=None):
         """Fill every missing value of ``X`` on-line.
 
         Parameters
@@ -260,6 +280,9 @@ class CRBMImputer(BaseMotionImputer):
             time order.  Observed values come back unchanged.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context, for a model fitted with one (which needs
+            it); frame ``t`` is filled given its own context.
         style : label or array-like of shape (n_frames,) or (n_frames, \
 n_classes), default=None
             A model of styles only: the style of every frame.  None infers
@@ -275,12 +298,19 @@ n_classes), default=None
             ``n_draws`` on-line fills; no missing value is left.
         """
         return self._impute(
-            X, sequence_ids, style, self.n_draws, self.random_state, True
+            X, sequence_ids, context, style, self.n_draws, self.random_state, True
         )
 
     @limit_blas_threads(chain_rows)
     def sample(
-        self, X, n_samples=1, *, sequence_ids=None, style=None, random_state=None
+        self,
+        X,
+        n_samples=1,
+        *,
+        sequence_ids=None,
+        context=None,
+        style=None,
+        random_state=None,
     ):
         """Draw independent on-line fills of ``X`` (multiple imputation).
 
@@ -298,6 +328,8 @@ n_classes), default=None
             Number of fills.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
+        context : array-like of shape (n_frames, n_context), default=None
+            Every frame's context (see :meth:`transform`).
         style : label or array-like, default=None
             A model of styles only: every frame's style (see
             :meth:`transform`).
@@ -311,17 +343,26 @@ n_classes), default=None
         """
         n_samples = check_count(n_samples, "n_samples", minimum=1)
         random_state = self.random_state if random_state is None else random_state
-        return self._impute(X, sequence_ids, style, n_samples, random_state, False)
+        return self._impute(
+            X, sequence_ids, context, style, n_samples, random_state, False
+        )
 
     @property
     def _packed_parameters(self):
         """The model's parameter buffer: its namespace and device."""
-        return self.estimator_._packed_parameters
+        return self.estimator_.conditional_layers()[0].flat
 
-    def _impute(self, X, sequence_ids, style, n_draws, random_state, average):
+    def _matrix_product_size(self, n_features=None):
+        """The model's (:mod:`sklearn_crbm.utils._threads`)."""
+        if _is_fitted(self):
+            return self.estimator_._matrix_product_size(n_features)
+        model = ConditionalRBM() if self.estimator is None else self.estimator
+        return model._matrix_product_size(n_features)
+
+    def _impute(self, X, sequence_ids, context, style, n_draws, random_state, average):
         X, mask, sequences = self._check_transform_input(X, sequence_ids)
         ops = array_ops(X)
-        context = self.estimator_._online_context(X, style)
+        context = self.estimator_.fill_in_context(X, context=context, style=style)
         if not bool(ops.any(mask)):
             return (
                 X if average else copy_array(ops.broadcast_to(X, (n_draws, *X.shape)))
@@ -379,7 +420,7 @@ n_classes), default=None
         ``(frame_context, hypotheses)``.  Returns an array of shape
         ``(n_draws, n_frames, n_features)`` in the model's dtype.
         """
-        layers = self.estimator_._layers()
+        layers = self.estimator_.conditional_layers()
         dtype, ops = layers[0].dtype, layers[0].ops
         X = ops.astype(X, dtype)
         frame_context, hypotheses = context
@@ -438,15 +479,17 @@ n_classes), default=None
 MAX_CHANNEL_WEIGHT = 3.0
 
 
-def _complete_styles(estimator, y, rows, n_frames):
+def _complete_styles(estimator, y, rows, n_frames, context):
     """The styles of the complete frames, for a model of styles (else None)."""
     if not get_tags(estimator).target_tags.required:
         return None
     if y is None:
-        raise ValueError(
-            f"CRBMImputer around {type(estimator).__name__} needs y in fit: the "
-            "style of every training frame."
-        )
+        if context is None:
+            raise ValueError(
+                f"CRBMImputer around {type(estimator).__name__} needs y in fit: "
+                "the style of every training frame (or a real-valued context=)."
+            )
+        return None
     y = np.asarray(y)
     if y.ndim == 0 or len(y) != n_frames:
         raise ValueError(
@@ -456,16 +499,23 @@ def _complete_styles(estimator, y, rows, n_frames):
     return y[rows]
 
 
-def _residual_variance(model, X, sequence_ids, styles):
+def _complete_rows(context, rows, n_frames, X):
+    """The rows of the complete frames ``X`` of the context of ``n_frames``."""
+    context = check_context(context, n_frames, None, X)
+    return array_ops(X).take(context, rows, axis=0)
+
+
+def _residual_variance(model, X, sequence_ids, styles, context):
     """Each channel's variance of ``X - model.predict_next(X)``.
 
     Over the frames with a full past in their sequence (all frames if none
-    has one), given the frames' ``styles`` for a model of styles.
+    has one), given the frames' ``styles`` (a model of styles) or context.
     """
     ops = array_ops(X)
+    residuals = X - model.predict_next(
+        X, sequence_ids=sequence_ids, context=context, style=styles
+    )
     sequences = check_sequence_ids(sequence_ids, X.shape[0])
-    context = model._online_context(X, styles)[0]
-    residuals = X - model._predict_frames(X, sequences, context=context)
     rows = sequences.valid_frames(model.history_length)
     if len(rows):
         residuals = ops.take(residuals, rows, axis=0)
@@ -488,6 +538,8 @@ def _check_frozen(model, X):
             "imputer on data with the model's features (same preprocessing)."
         )
     check_same_place(
-        model._packed_parameters, X, f"The frozen {type(model).__name__} holds"
+        model.conditional_layers()[0].flat,
+        X,
+        f"The frozen {type(model).__name__} holds",
     )
     return model

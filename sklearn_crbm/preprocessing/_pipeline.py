@@ -21,15 +21,18 @@ __all__ = ["MotionPipeline", "make_motion_pipeline", "make_motion_preprocessor"]
 
 
 def _check_routing(params):
-    """Say how to turn routing on when ``sequence_ids`` is passed without it."""
-    if "sequence_ids" in params and not sklearn.get_config()["enable_metadata_routing"]:
+    """Say how to turn routing on when ``sequence_ids`` or ``context`` is
+    passed without it."""
+    routed = [name for name in ("sequence_ids", "context") if name in params]
+    if routed and not sklearn.get_config()["enable_metadata_routing"]:
+        names = " and ".join(routed)
         raise ValueError(
-            "sequence_ids reaches the steps of a pipeline only through "
-            "scikit-learn's metadata routing, which is off. Turn it on once, "
-            "at the top of the script: sklearn.set_config("
+            f"{names} reach{'es' * (len(routed) == 1)} the steps of a pipeline "
+            "only through scikit-learn's metadata routing, which is off. Turn it "
+            "on once, at the top of the script: sklearn.set_config("
             "enable_metadata_routing=True) (or for a block: with "
             "sklearn.config_context(enable_metadata_routing=True): ...). The "
-            "package's steps then receive sequence_ids wherever they need them."
+            f"package's steps then receive {names} wherever they need them."
         )
 
 
@@ -195,9 +198,9 @@ class MotionPipeline(Pipeline):
         random_state : int, RandomState instance or None, default=None
             Seeds the generation.
         **params : dict
-            Passed on to the model's ``sample`` (for a
-            :class:`~sklearn_crbm.ConditionalRBM`: ``n_gibbs``,
-            ``hidden_noise``, ``sample_visibles``, ``n_jobs``).
+            Passed on to the model's ``sample``: ``context`` (every new
+            frame's context, for a model fitted with one), ``style``,
+            ``n_gibbs``, ``hidden_noise``, ``sample_visibles``, ``n_jobs``.
 
         Returns
         -------
@@ -225,10 +228,10 @@ class MotionPipeline(Pipeline):
         """Say in the raw channels' terms what a seed of the wrong shape lacks."""
         shape = np.shape(history) if history is not None else None
         model = self._final_estimator
-        width = max(model.history_length, 1)
         n_model = getattr(model, "n_features_in_", None)
         if shape is None or len(shape) not in (2, 3) or n_model is None:
             return  # the model's own checks say what is wrong
+        width = max(model.history_length, 1)
         n_raw = len(self.skeleton.feature_names)
         if shape[-1] == n_model and shape[-2] >= width:
             return

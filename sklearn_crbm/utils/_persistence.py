@@ -15,10 +15,14 @@ Formats:
    the layout before the layer redesign hold ``sklearn_crbm._crbm_math``
    objects; that module is kept only to say so (:func:`raise_removed_layout`).
 1. The layer layout: each model's parameters in a layer object
-   (``sklearn_crbm._crbm_layer``, ``_factored_layer``, ``_labelled``).
+   (:mod:`sklearn_crbm.layers`).  Pickles written before the layers moved
+   into that package name their old modules, which :data:`MOVED_MODULES`
+   maps to the new ones (and ``sklearn_crbm._labelled.LabelledLayer`` is
+   the CRBM layer).
 """
 
 import importlib
+import sys
 import warnings
 from functools import reduce
 
@@ -36,6 +40,15 @@ PICKLE_FORMAT = 1
 
 # The key of the format in an estimator's pickled state.
 _FORMAT_KEY = "_sklearn_crbm_pickle_format"
+
+# Modules of format 1's fitted state that moved into sklearn_crbm.layers, by
+# the names pickles written before the move give them.
+MOVED_MODULES = {
+    "sklearn_crbm._layer": "sklearn_crbm.layers._base",
+    "sklearn_crbm._crbm_layer": "sklearn_crbm.layers._crbm",
+    "sklearn_crbm._factored_layer": "sklearn_crbm.layers._factored",
+    "sklearn_crbm._parameters": "sklearn_crbm.layers._parameters",
+}
 
 
 def _package_version():
@@ -94,6 +107,9 @@ def _unpickle(saved_format, saved_version, module, qualname):
     check_pickle_format(
         saved_format, qualname, saved_by=f"sklearn_crbm {saved_version}"
     )
+    # the state, read next, may name the layers' modules before they moved
+    for old, new in MOVED_MODULES.items():
+        sys.modules.setdefault(old, importlib.import_module(new))
     cls = reduce(getattr, qualname.split("."), importlib.import_module(module))
     return cls.__new__(cls)
 

@@ -107,9 +107,11 @@ def limit_blas_threads(rows):
     rows : callable
         ``rows(estimator, *args, **kwargs)`` with the method's arguments:
         the number of rows of one matrix product in the method's loop.  The
-        product's size is that times the multiply-adds per row of the model's
-        largest product (see :func:`_width`).  Errors count as a small
-        product: the method itself reports bad input.
+        product's size is that times the multiply-adds per row of the
+        model's largest product, which the model's layers give
+        (``estimator._matrix_product_size(n_features)``, from
+        :meth:`~sklearn_crbm.layers.ConditionalLayer.product_size`).  Errors
+        count as a small product: the method itself reports bad input.
 
     Returns
     -------
@@ -130,32 +132,16 @@ def limit_blas_threads(rows):
 def _product_size(rows, estimator, args, kwargs):
     try:
         n_rows = rows(estimator, *args, **kwargs)
-        return n_rows * _width(estimator, _n_features(estimator, args))
+        return n_rows * estimator._matrix_product_size(_n_features(args))
     except Exception:  # bad input: the method raises its own clear error
         return 0
 
 
-def _n_features(estimator, args):
-    """Features of the data passed first, else those seen in ``fit``."""
+def _n_features(args):
+    """Features of the data passed first (None: the model's own, once fitted)."""
     if args and np.ndim(args[0]) == 2:
         return int(np.shape(args[0])[1])
-    return estimator.n_features_in_
-
-
-def _width(estimator, n_features):
-    """Multiply-adds per row of the largest matrix product of the model's layers.
-
-    A fitted model asks its layers
-    (:meth:`~sklearn_crbm._layer.ConditionalLayer.product_size`); before the
-    first fit, the widest layer its parameters ask for: hidden units times
-    the visible and past inputs.
-    """
-    model = getattr(estimator, "estimator_", estimator)
-    if hasattr(model, "n_features_in_"):
-        return max(layer.product_size() for layer in model._layers())
-    sizes = [int(s) for s in np.ravel(model.n_components)]
-    inputs = max([n_features, *sizes[:-1]]) * (1 + model._n_lags)
-    return max(sizes) * inputs
+    return None
 
 
 def batch_rows(estimator, *args, **kwargs):

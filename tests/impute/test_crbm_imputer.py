@@ -345,8 +345,8 @@ def test_stacked_estimator(test_data, n_particles):
 
 
 def test_observed_log_likelihood_hand_computed():
-    from sklearn_crbm._crbm_layer import CRBMLayer
     from sklearn_crbm._gibbs import observed_log_likelihood
+    from sklearn_crbm.layers._crbm import CRBMLayer
 
     def frame_rbms(n_features, visible_type, n_frames):
         layer = CRBMLayer(n_features, 2, 1, 1, visible_type, np.float64)
@@ -372,8 +372,8 @@ def test_observed_log_likelihood_hand_computed():
 
 
 def test_stacked_gibbs_with_one_layer_is_gibbs_frames():
-    from sklearn_crbm._crbm_layer import CRBMLayer
     from sklearn_crbm._gibbs import gibbs_frames, stacked_gibbs_frames
+    from sklearn_crbm.layers._crbm import CRBMLayer
 
     rng = np.random.default_rng(0)
     params = CRBMLayer(4, 5, 2, 2, "gaussian", np.float64).initialize(rng)

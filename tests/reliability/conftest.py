@@ -84,7 +84,15 @@ def styles(oscillations):
 
 
 @pytest.fixture(scope="session")
-def fitted(oscillations, styles, walker):
+def context(oscillations):
+    """A control signal of two columns for every frame of ``oscillations``."""
+    ids = oscillations[1]
+    sign = np.where(ids % 2 == 1, 1.0, -1.0)
+    return np.column_stack([sign, np.linspace(-1, 1, len(ids))])
+
+
+@pytest.fixture(scope="session")
+def fitted(oscillations, styles, walker, context):
     """One fitted instance of every public estimator, keyed by a short name.
 
     Session-scoped: tests must not fit or mutate these (use
@@ -94,6 +102,10 @@ def fitted(oscillations, styles, walker):
     Z = ExpMapEncoder(walker.skeleton).fit_transform(walker.data)
     return {
         "crbm": small_crbm().fit(X, sequence_ids=ids),
+        "context_crbm": small_crbm().fit(X, sequence_ids=ids, context=context),
+        "context_imputer": CRBMImputer(small_crbm(), n_gibbs=2, random_state=0).fit(
+            X, sequence_ids=ids, context=context
+        ),
         "stack": small_stack().fit(X, sequence_ids=ids),
         "factored": small_factored().fit(X, styles, sequence_ids=ids),
         "labelled": small_labelled().fit(X, styles, sequence_ids=ids),

@@ -80,13 +80,14 @@ def _params(cases):
 
 
 @pytest.fixture
-def ctx(oscillations, styles, walker, fitted, factories, real_files, tmp_path):
+def ctx(oscillations, styles, context, walker, fitted, factories, real_files, tmp_path):
     X, ids = oscillations
     Z = fitted["expmap"].transform(walker.data)
     return types.SimpleNamespace(
         X=X,
         ids=ids,
         styles=styles,
+        context=context,
         n=len(X),
         walker=walker,
         skeleton=walker.skeleton,
@@ -161,8 +162,12 @@ STYLE_METHODS = (
 def _style_model_entries(key, name):
     """A model of styles' entry points, each given every frame's style ("high")."""
 
-    def method(method_name, *args):
-        return lambda c, X: getattr(c.f[key], method_name)(X, *args)
+    def method(method_name, style=None):
+        if method_name == "score":  # the labels are score's y
+            return lambda c, X: c.f[key].score(X, style)
+        if style is None:
+            return lambda c, X: getattr(c.f[key], method_name)(X)
+        return lambda c, X: getattr(c.f[key], method_name)(X, style=style)
 
     return [
         Entry(
@@ -763,7 +768,7 @@ for _key, _name in STYLE_MODELS:
             ),
             **{
                 f"{_name}.{m}": lambda c, s, k=_key, m=m: getattr(c.f[k], m)(
-                    c.X, "high", sequence_ids=s
+                    c.X, sequence_ids=s, **{"y" if m == "score" else "style": "high"}
                 )
                 for m in STYLE_METHODS
             },
@@ -1058,7 +1063,10 @@ def _style_calls():
     for key, name in STYLE_MODELS:
 
         def use(m, k=key):
-            return lambda c, s: getattr(c.f[k], m)(c.X, s, sequence_ids=c.ids)
+            labels = "y" if m == "score" else "style"
+            return lambda c, s: getattr(c.f[k], m)(
+                c.X, sequence_ids=c.ids, **{labels: s}
+            )
 
         calls += [
             (
@@ -1171,7 +1179,7 @@ OTHER_STYLE_CASES = [
         "CRBMImputer(ConditionalRBM).transform-a style",
         lambda c: c.f["crbm_imputer"].transform(_one(c.X, np.nan), style="high"),
         ValueError,
-        "ConditionalRBM has no styles: fill in without style=",
+        "ConditionalRBM has no styles: give context= instead of style=",
     ),
 ]
 
@@ -1300,8 +1308,6 @@ def _sample_cases():
     ):
         for params, match in SAMPLE_PARAMS:
             label = ",".join(f"{k}={v!r}" for k, v in params.items())
-            if key in dict(STYLE_MODELS):  # whose sample counts n_frames
-                match = match.replace("n_samples", "n_frames")
 
             def call(c, key=key, params=params):
                 kwargs = {"n_samples": 3, **params, **_style_of(c.f[key])}
@@ -1596,13 +1602,13 @@ UNFITTED = [
         (f"{name}.{method}", lambda c, k=key, call=call: call(c.new[k](), c))
         for key, name in STYLE_MODELS
         for method, call in [
-            ("transform", lambda m, c: m.transform(c.X, "high")),
-            ("score_samples", lambda m, c: m.score_samples(c.X, "high")),
-            ("predict_next", lambda m, c: m.predict_next(c.X, "high")),
+            ("transform", lambda m, c: m.transform(c.X, style="high")),
+            ("score_samples", lambda m, c: m.score_samples(c.X, style="high")),
+            ("predict_next", lambda m, c: m.predict_next(c.X, style="high")),
             ("score", lambda m, c: m.score(c.X, c.styles)),
             (
                 "estimate_log_likelihood",
-                lambda m, c: m.estimate_log_likelihood(c.X, "high"),
+                lambda m, c: m.estimate_log_likelihood(c.X, style="high"),
             ),
             ("predict", lambda m, c: m.predict(c.X)),
             ("predict_proba", lambda m, c: m.predict_proba(c.X)),
@@ -2306,7 +2312,7 @@ FAILED_FITS = [
                         lambda c: c.styles,
                         sequence_ids=ONE_FRAME_EACH,
                     ),
-                    lambda c, e: e.transform(c.X, "high"),
+                    lambda c, e: e.transform(c.X, style="high"),
                 ),
                 NotFittedError,
                 "not fitted",
@@ -2421,7 +2427,7 @@ CLI_CASES = {
 
 @pytest.mark.parametrize("name", list(CLI_CASES))
 def test_command_line_reports_bad_input_without_a_traceback(name, tmp_path, capsys):
-    from sklearn_crbm._cli import main
+    from sklearn_crbm.cli import main
 
     argv, message = CLI_CASES[name]
     status = main(argv(tmp_path))
@@ -2429,3 +2435,118 @@ def test_command_line_reports_bad_input_without_a_traceback(name, tmp_path, caps
     err = capsys.readouterr().err
     assert "Traceback" not in err
     assert re.search(message, err, flags=re.DOTALL), err
+
+
+# ----------------------------------------------------------------- context
+# Every entry point of a model of a context, given a context ``c`` (the
+# frames': ``c.context``, or a bad one).
+CONTEXT_ENTRIES = {
+    "ConditionalRBM.fit": lambda c, k: c.new["crbm"]().fit(c.X, context=k),
+    "ConditionalRBM.partial_fit(fitted)": lambda c, k: copy.deepcopy(
+        c.f["context_crbm"]
+    ).partial_fit(c.X, context=k),
+    **{
+        f"ConditionalRBM.{m}": lambda c, k, m=m: getattr(c.f["context_crbm"], m)(
+            c.X, context=k
+        )
+        for m in (
+            "transform",
+            "predict_next",
+            "score_samples",
+            "score",
+            "estimate_log_likelihood",
+        )
+    },
+    "ConditionalRBM.sample": lambda c, k: c.f["context_crbm"].sample(c.n, context=k),
+    "CRBMImputer.fit": lambda c, k: CRBMImputer(c.new["crbm"]()).fit(c.X, context=k),
+    "CRBMImputer.transform": lambda c, k: c.f["context_imputer"].transform(
+        _one(c.X, np.nan), context=k
+    ),
+    "CRBMImputer.sample": lambda c, k: c.f["context_imputer"].sample(
+        _one(c.X, np.nan), 2, context=k
+    ),
+}
+FITTED_WITH_CONTEXT = [name for name in CONTEXT_ENTRIES if ".fit" not in name]
+BAD_CONTEXTS = {
+    "NaN": (lambda k: np.where(k > 0.5, np.nan, k), ValueError, "NaN or infinity"),
+    "infinity": (lambda k: np.where(k > 0.5, np.inf, k), ValueError, "NaN or infinity"),
+    "text": (lambda k: np.full(k.shape, "fast"), TypeError, "array of numbers"),
+    "sparse": (
+        lambda k: sp.csr_matrix(k),
+        TypeError,
+        "dense array, got a sparse",
+    ),
+    "one signal as 1-D": (lambda k: k[:, 0], ValueError, r"reshape\(-1, 1\)"),
+    "a row too few": (lambda k: k[:-1], ValueError, "one row of context per frame"),
+    "no columns": (lambda k: k[:, :0], ValueError, "one row of context per frame"),
+}
+
+
+def _context_cases():
+    cases = [
+        Case(
+            f"{name}-{kind}",
+            lambda c, call=call, make=make: call(c, make(c.context)),
+            exc,
+            match,
+        )
+        for name, call in CONTEXT_ENTRIES.items()
+        for kind, (make, exc, match) in BAD_CONTEXTS.items()
+    ]
+    cases += [
+        Case(
+            f"{name}-no context",
+            lambda c, call=CONTEXT_ENTRIES[name]: call(c, None),
+            ValueError,
+            r"fitted with a context of 2 columns per frame.*pass context=",
+        )
+        for name in FITTED_WITH_CONTEXT
+    ]
+    cases += [
+        Case(
+            f"{name}-3 columns",
+            lambda c, call=CONTEXT_ENTRIES[name]: call(
+                c, np.hstack([c.context, c.context[:, :1]])
+            ),
+            ValueError,
+            r"context must have shape \(n, 2\)",
+        )
+        for name in FITTED_WITH_CONTEXT
+    ]
+    return cases + [
+        Case(
+            "ConditionalRBM without context.transform-a context",
+            lambda c: c.f["crbm"].transform(c.X, context=c.context),
+            ValueError,
+            "fitted without context, so it takes none",
+        ),
+        Case(
+            "ConditionalRBM.transform-a style",
+            lambda c: c.f["context_crbm"].transform(c.X, style="high"),
+            ValueError,
+            "ConditionalRBM has no styles: give context= instead of style=",
+        ),
+        Case(
+            "LabelledCRBM.fit-labels and context",
+            lambda c: c.new["labelled"]().fit(c.X, c.styles, context=c.context),
+            ValueError,
+            "got both y and context=: give the labels",
+        ),
+        Case(
+            "FactoredCRBM.transform-style and context",
+            lambda c: c.f["factored"].transform(c.X, style="high", context=c.context),
+            ValueError,
+            "got both style= and context=",
+        ),
+        Case(
+            "CRBMImputer.fit-context of another length",
+            lambda c: CRBMImputer(c.new["crbm"]()).fit(c.X, context=c.context[:-1]),
+            ValueError,
+            r"with n = 60: one row of context per frame; got shape \(59, 2\)",
+        ),
+    ]
+
+
+@pytest.mark.parametrize("case", _params(_context_cases()))
+def test_bad_context(case, ctx):
+    _check(case, ctx)

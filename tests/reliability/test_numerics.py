@@ -8,10 +8,10 @@ import pytest
 import sklearn
 
 from sklearn_crbm import TrainingDivergedError
-from sklearn_crbm._crbm_layer import CRBMFrames, CRBMLayer
-from sklearn_crbm._layer import logistic
 from sklearn_crbm.datasets import load_cmu35, make_walker
 from sklearn_crbm.impute import CRBMImputer
+from sklearn_crbm.layers._base import logistic
+from sklearn_crbm.layers._crbm import CRBMFrames, CRBMLayer
 from sklearn_crbm.preprocessing import (
     ExpMapEncoder,
     RootRelativeEncoder,
@@ -173,9 +173,9 @@ def test_style_models_stay_finite_on_cmu35(
         assert np.isfinite(model._layers()[0].flat).all()
         assert model.reconstruction_error_ < 62  # better than the mean
         outputs = {
-            "transform": model.transform(X, y, sequence_ids=ids),
-            "score_samples": model.score_samples(X, y, sequence_ids=ids),
-            "predict_next": model.predict_next(X, y, sequence_ids=ids),
+            "transform": model.transform(X, style=y, sequence_ids=ids),
+            "score_samples": model.score_samples(X, style=y, sequence_ids=ids),
+            "predict_next": model.predict_next(X, style=y, sequence_ids=ids),
             "predict_proba": model.predict_proba(X, sequence_ids=ids),
             "sample": model.sample(30, style="jog", n_sequences=4, random_state=0),
         }
@@ -210,7 +210,11 @@ def _params(dtype, n_features=3, n_components=4):
 
 def _frame_rbms(params, visible_bias, hidden_bias):
     return CRBMFrames(
-        visible_bias, hidden_bias, params.visible_std, params.binary, params.weights
+        visible_bias,
+        hidden_bias,
+        params.visible_std,
+        params.visible_units,
+        params.weights,
     )
 
 
@@ -339,7 +343,7 @@ def test_style_models_are_stable_for_huge_activations(
         elif method == "predict_proba":
             out = model.predict_proba(X, sequence_ids=ids)
         else:
-            out = getattr(model, method)(X, styles, sequence_ids=ids)
+            out = getattr(model, method)(X, style=styles, sequence_ids=ids)
     assert np.isfinite(out).all()
     if method in ("transform", "predict_proba"):
         assert out.min() >= 0.0 and out.max() <= 1.0
@@ -373,7 +377,7 @@ def test_stack_style_models_and_imputers_are_stable_for_large_inputs(
                 for output in (
                     fitted[key].transform(X, sequence_ids=ids),
                     fitted[key].score_samples(X, sequence_ids=ids),
-                    fitted[key].predict_next(X, "low", sequence_ids=ids),
+                    fitted[key].predict_next(X, style="low", sequence_ids=ids),
                     fitted[key].predict_proba(X, sequence_ids=ids),
                     fitted[key].sample(5, history=X[:6], style="high"),
                 )

@@ -194,7 +194,10 @@ def test_style_model_sequences_are_independent(key, data, fitted, oscillations):
     )
     model = fitted[key]
     for name in CRBM_METHODS:
-        method = getattr(model, name)
+
+        def method(X, style=None, *, sequence_ids=None, name=name):
+            return getattr(model, name)(X, sequence_ids=sequence_ids, style=style)
+
         for style_args in ((styles,), ()):
             together = method(X, *style_args, sequence_ids=ids)
             alone = _per_sequence(method, X, ids, *style_args)

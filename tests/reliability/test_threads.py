@@ -72,7 +72,7 @@ CALLS = {
         10, n_sequences=2, random_state=k
     ),
     "FactoredCRBM.transform": lambda f, X, ids, k: f["factored"].transform(
-        X, "high", sequence_ids=ids
+        X, style="high", sequence_ids=ids
     ),
     "FactoredCRBM.predict_proba": lambda f, X, ids, k: f["factored"].predict_proba(
         X, sequence_ids=ids

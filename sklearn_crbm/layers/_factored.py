@@ -2,10 +2,11 @@
 
 A frame ``v`` (``n_features`` Gaussian units of unit variance), binary
 hidden units ``h`` (``n_components``), the flattened past ``p`` (``n_lags``
-frames, lag-major) and per-frame label weights ``y`` (the *context*,
-``n_classes``; one-hot for a labelled frame).  The labels give real-valued
-style features ``z = y R``, and every interaction goes through factors
-that the style features gate (three-way multiplicative interactions)::
+frames, lag-major) and the frame's *context* ``y`` (``n_context`` real
+values: label weights, one-hot for a labelled frame, or control signals).
+The context gives real-valued style features ``z = y R``, and every
+interaction goes through factors that the style features gate (three-way
+multiplicative interactions)::
 
     c_hat = c + ((p P_A) * (z Z_A)) A_v.T        dynamic visible bias
     b_hat = b + ((p P_B) * (z Z_B)) B_h.T        dynamic hidden bias
@@ -23,10 +24,16 @@ import functools
 
 import numpy as np
 
-from ._gibbs import HiddenSampler
-from ._layer import ConditionalLayer, FrameRBMs, TrainingWorkspace
+from .._gibbs import HiddenSampler
+from ..utils._random import sample_bernoulli
+from ._base import (
+    GAUSSIAN,
+    VISIBLE_UNITS,
+    ConditionalLayer,
+    FrameRBMs,
+    TrainingWorkspace,
+)
 from ._parameters import ParameterGroup, small_normal
-from .utils._random import sample_bernoulli
 
 __all__ = ["FactoredFrames", "FactoredLayer"]
 
@@ -80,7 +87,7 @@ def _groups(shared):
             "visible_from_factors",
             lambda p: (p.n_features, p.n_factors),
         ),
-        _group("label_features", lambda p: (p.n_classes, p.n_style_features)),
+        _group("label_features", lambda p: (p.n_context, p.n_style_features)),
     ]
     style = (
         ["style_factors"]
@@ -124,7 +131,7 @@ class FactoredFrames(FrameRBMs):
     def __init__(
         self, visible_bias, hidden_bias, gates, visible_factors, hidden_factors
     ):
-        super().__init__(visible_bias, hidden_bias, None, False)
+        super().__init__(visible_bias, hidden_bias, None, VISIBLE_UNITS[GAUSSIAN])
         self.gates = gates
         self.visible_factors = visible_factors
         self.hidden_factors = hidden_factors
@@ -173,7 +180,7 @@ class FactoredLayer(ConditionalLayer):
 
     Parameters
     ----------
-    n_features, n_components, n_factors, n_style_features, n_classes, order : int
+    n_features, n_components, n_factors, n_style_features, n_context, order : int
     dtype : dtype
     shared_style_weights : bool, default=True
         One style-feature-to-factor matrix for the three kinds of factor.
@@ -190,7 +197,7 @@ class FactoredLayer(ConditionalLayer):
     past_hidden_factors, hidden_from_factors : ndarray
         ``P_B`` (n_lags * n_features, n_factors), ``B_h`` (n_components,
         n_factors).
-    label_features : ndarray of shape (n_classes, n_style_features)
+    label_features : ndarray of shape (n_context, n_style_features)
         ``R``.
     style_factors or style_undirected, style_hidden, style_visible : ndarray
         ``Z`` (shared) or ``Z_W``, ``Z_B``, ``Z_A``, each (n_style_features,
@@ -205,7 +212,7 @@ class FactoredLayer(ConditionalLayer):
         n_components,
         n_factors,
         n_style_features,
-        n_classes,
+        n_context,
         order,
         dtype,
         *,
@@ -217,7 +224,7 @@ class FactoredLayer(ConditionalLayer):
         self.n_components = n_components
         self.n_factors = n_factors
         self.n_style_features = n_style_features
-        self.n_classes = n_classes
+        self.n_context = n_context
         self.order = order
         self.shared_style_weights = shared_style_weights
         self._allocate(dtype, layout=layout, ops=ops)
@@ -231,7 +238,7 @@ class FactoredLayer(ConditionalLayer):
         return self.order
 
     def style_features(self, context):
-        """``z = y R`` of every frame (``context`` holds the label weights ``y``)."""
+        """``z = y R`` of every frame (``context`` holds ``y``)."""
         return self.ops.matmul(context, self.label_features)
 
     def _terms(self, history, context):
@@ -275,11 +282,9 @@ class FactoredLayer(ConditionalLayer):
             self.hidden_factors,
         )
 
-    def frame_rbms(self, history, context=None):
+    def build_frame_rbms(self, invariants, history, context=None, *, out=None):
         if context is None:
-            raise ValueError(
-                "A factored layer needs every frame's label weights (its context)."
-            )
+            raise ValueError("A factored layer needs every frame's context.")
         return self._rbms(self._terms(history, context))
 
     # ------------------------------------------------------------ training

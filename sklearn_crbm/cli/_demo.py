@@ -11,13 +11,13 @@ import time
 import numpy as np
 from sklearn.impute import KNNImputer
 
-from ._base import DEAD_FRACTION, generated_liveliness
-from .datasets import write_amc, write_bvh
-from .impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
-from .metrics import judge_generated_motion
-from .model_selection import compare_imputers, make_fillin_cases
-from .preprocessing import make_motion_preprocessor
-from .utils import random_windows
+from .._base import DEAD_FRACTION, generated_liveliness
+from ..datasets import write_amc, write_bvh
+from ..impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
+from ..metrics import judge_generated_motion
+from ..model_selection import compare_imputers, make_fillin_cases
+from ..preprocessing import make_motion_preprocessor
+from ..utils import random_windows
 
 __all__ = ["run_demo"]
 
@@ -233,7 +233,7 @@ def _write_generated(output, preprocessor, train, generated):
 
 
 def _draw(args, imputer, preprocessor, Z_train, train, cases, generated):
-    from .plotting import (
+    from ..plotting import (
         plot_filled_channels,
         plot_hidden_activations,
         plot_motion_strip,
@@ -324,7 +324,7 @@ def save_gif(path, skeleton, sequences, *, frame_rate, step=1, **kwargs):
     """
     import matplotlib.pyplot as plt
 
-    from .plotting import animate_motions, save_animation
+    from ..plotting import animate_motions, save_animation
 
     height = 3.0 if kwargs.get("proba") is None else 5.0
     figure = plt.figure(figsize=(max(2.6 * len(sequences), 5.0), height))

@@ -1,7 +1,7 @@
 """Command line: ``python -m sklearn_crbm {demo,fetch,fit,sample,styles}``.
 
 Argument parsing and printing only: the commands' arguments are listed in
-:mod:`._cli_options`, the demo lives in :mod:`._demo`, the styles command in
+:mod:`._options`, the demo lives in :mod:`._demo`, the styles command in
 :mod:`._style_demo`, and everything measured or generated is done by the
 library.
 """
@@ -17,14 +17,10 @@ import numpy as np
 import sklearn
 from sklearn.utils import Bunch
 
-from ._base import generated_liveliness
-from ._cli_options import COMMANDS, MAX_DEFAULT_RATE
-from ._crbm import ConditionalRBM
-from ._demo import liveliness_text, save_gif
-from ._demo import run_demo as _run_demo
-from ._factored import FactoredCRBM
-from ._style_demo import run_styles as _run_styles
-from .datasets import (
+from .._base import generated_liveliness
+from .._crbm import ConditionalRBM
+from .._factored import FactoredCRBM
+from ..datasets import (
     fetch_bandai_walks,
     fetch_cmu35,
     fetch_mit_walk,
@@ -35,7 +31,11 @@ from .datasets import (
     read_bvh_folder,
     resample_frames,
 )
-from .preprocessing import MotionPipeline, make_motion_pipeline
+from ..preprocessing import MotionPipeline, make_motion_pipeline
+from ._demo import liveliness_text, save_gif
+from ._demo import run_demo as _run_demo
+from ._options import COMMANDS, MAX_DEFAULT_RATE
+from ._style_demo import run_styles as _run_styles
 
 __all__ = ["main"]
 

@@ -12,6 +12,13 @@ matrix product::
 
     [c_hat, b_hat] = history @ dynamic.T + [c, b]
 
+A per-frame context ``y_t`` (``n_context`` real values: a control signal,
+or label weights) adds to both through the weights ``context_weights`` of
+shape ``(n_features + n_components, n_context)``, stacked as ``dynamic``
+is::
+
+    [c_hat, b_hat] = history @ dynamic.T + [c, b] + y_t @ context_weights.T
+
 When ``order != hidden_order`` the blocks of lags a group does not use are
 kept at exactly zero.  Every frame shares ``W``: the frame RBMs differ in
 their biases only.  The paper fixes the visible standard deviation ``s`` at
@@ -20,15 +27,37 @@ their biases only.  The paper fixes the visible standard deviation ``s`` at
 """
 
 import math
+from numbers import Integral
 
 import numpy as np
+from sklearn.utils._param_validation import Interval
 
-from ._gibbs import HiddenSampler
-from ._layer import ConditionalLayer, FrameRBMs, TrainingWorkspace
+from .._gibbs import HiddenSampler
+from ..utils._array_api import array_ops, same_memory
+from ._base import ConditionalLayer, FrameRBMs, TrainingWorkspace
 from ._parameters import ParameterGroup, small_normal
-from .utils._array_api import array_ops, same_memory
 
-__all__ = ["MIN_LOG_VARIANCE", "CRBMFrames", "CRBMLayer", "shift_centred"]
+__all__ = [
+    "MIN_LOG_VARIANCE",
+    "ORDER_CONSTRAINTS",
+    "CRBMFrames",
+    "CRBMLayer",
+    "hidden_order_of",
+    "shift_centred",
+]
+
+# The past frames of a CRBM: ``order`` feed the visibles, ``hidden_order``
+# (None: ``order``) the hidden units.
+ORDER_CONSTRAINTS = {
+    "order": [Interval(Integral, 0, None, closed="left")],
+    "hidden_order": [None, Interval(Integral, 0, None, closed="left")],
+}
+
+
+def hidden_order_of(model):
+    """A CRBM model's ``hidden_order``, None standing for its ``order``."""
+    return model.order if model.hidden_order is None else model.hidden_order
+
 
 # Learned visible variances are kept at or above 1e-4 (s >= 0.01, in the units
 # of standardised data): a channel that its past predicts almost exactly
@@ -75,6 +104,13 @@ CRBM_GROUPS = (
         lambda p, rng: np.zeros(p.n_features, p.dtype),
         decayed=False,
     ),
+    # last: without context it is empty and draws nothing
+    ParameterGroup(
+        "context_weights",
+        lambda p: (p.n_features + p.n_components, p.n_context),
+        lambda p, rng: small_normal(rng, p.context_weights.shape, p.dtype),
+        decayed=True,
+    ),
 )
 
 
@@ -83,8 +119,8 @@ class CRBMFrames(FrameRBMs):
 
     Parameters
     ----------
-    visible_bias, hidden_bias, visible_std, binary
-        As :class:`~sklearn_crbm._layer.FrameRBMs`.
+    visible_bias, hidden_bias, visible_std, units, frame_invariant
+        As :class:`~sklearn_crbm.layers.FrameRBMs`.
     weights : ndarray of shape (n_components, n_features)
         ``W``.
     input_weights : ndarray of shape (n_components, n_features), default=None
@@ -98,11 +134,12 @@ class CRBMFrames(FrameRBMs):
         visible_bias,
         hidden_bias,
         visible_std,
-        binary,
+        units,
         weights,
         input_weights=None,
+        frame_invariant=False,
     ):
-        super().__init__(visible_bias, hidden_bias, visible_std, binary)
+        super().__init__(visible_bias, hidden_bias, visible_std, units, frame_invariant)
         self.weights = weights
         if input_weights is None:
             input_weights = weights if visible_std is None else weights / visible_std
@@ -154,13 +191,16 @@ class CRBMLayer(ConditionalLayer):
     n_features), ``hidden_bias`` (n_components,), ``visible_bias``
     (n_features,), ``dynamic`` (n_features + n_components, n_lags *
     n_features), the directed weights ``[A; B]`` (see the module docstring),
-    and ``log_visible_variance`` (n_features,).
+    ``log_visible_variance`` (n_features,) and ``context_weights``
+    (n_features + n_components, n_context).
 
     Parameters
     ----------
     n_features, n_components, order, hidden_order : int
     visible_type : {"gaussian", "binary"}
     dtype : dtype
+    n_context : int, default=0
+        Columns of the per-frame context.
     flat : ndarray of shape (n_parameters,), default=None
         The buffer to view; zeros if None.
     layout : {"C", "F"}, default="C"
@@ -178,6 +218,8 @@ class CRBMLayer(ConditionalLayer):
     """
 
     groups = CRBM_GROUPS
+    # layers pickled before contexts had none
+    n_context = 0
 
     def __init__(
         self,
@@ -188,6 +230,7 @@ class CRBMLayer(ConditionalLayer):
         visible_type,
         dtype,
         *,
+        n_context=0,
         flat=None,
         layout="C",
         learned_variance=False,
@@ -200,6 +243,7 @@ class CRBMLayer(ConditionalLayer):
         self.order = order
         self.hidden_order = hidden_order
         self.visible_type = visible_type
+        self.n_context = n_context
         self.learned_variance = learned_variance
         self.fixed_variance = fixed_variance
         self.centered = centered
@@ -246,6 +290,16 @@ class CRBMLayer(ConditionalLayer):
         block = self.dynamic[n:, : self.hidden_order * n]
         return _lag_blocks(block, self.hidden_order, n)
 
+    @property
+    def context_to_visible(self):
+        """``L_v``, shape ``(n_features, n_context)``: context to visible biases."""
+        return self.context_weights[: self.n_features, ...]
+
+    @property
+    def context_to_hidden(self):
+        """``L_h``, shape ``(n_components, n_context)``: context to hidden biases."""
+        return self.context_weights[self.n_features :, ...]
+
     def dynamic_mask(self):
         """1 where a directed weight exists, 0 on the lags a group does not use."""
         n = self.n_features
@@ -256,12 +310,12 @@ class CRBMLayer(ConditionalLayer):
 
     # --------------------------------------------------------- frame RBMs
 
-    def dynamic_biases(self, history, out=None, static=None):
-        """``c_hat`` and ``b_hat`` of each frame given its flattened history.
+    def dynamic_biases(self, history, context=None, out=None, static=None):
+        """``c_hat`` and ``b_hat`` of each frame given its history and context.
 
         Views of one array ``out`` of shape ``(n, n_features +
-        n_components)`` (one matrix product); ``static`` is ``[c, b]`` if
-        the caller keeps it at hand.
+        n_components)``; ``static`` is ``[c, b]`` if the caller keeps it at
+        hand.
         """
         n = self.n_features
         ops = self.ops
@@ -270,32 +324,53 @@ class CRBMLayer(ConditionalLayer):
         # one contiguous add is several times faster than two on strided halves
         if static is None:
             static = ops.concatenate((self.visible_bias, self.hidden_bias))
-        if self.n_lags == 0:
+        inputs = self.bias_inputs(history, context)
+        if not inputs:
             out[...] = static
-        else:
-            out = ops.matmul(history, self.dynamic.T, out=out)
-            out += static
+        for k, (name, values) in enumerate(inputs):
+            if k == 0:
+                out = ops.matmul(values, getattr(self, name).T, out=out)
+                out += static
+            else:
+                out += ops.matmul(values, getattr(self, name).T)
         return out[:, :n], out[:, n:]
 
-    def frame_rbms(self, history, context=None, *, out=None):
-        visible_bias, hidden_bias = self.dynamic_biases(history, out=out)
-        return CRBMFrames(
-            visible_bias, hidden_bias, self.visible_std, self.binary, self.weights
-        )
+    def bias_inputs(self, history, context):
+        """The inputs of the dynamic biases: ``(group, values)`` pairs.
 
-    def conditioner(self):
-        ops = self.ops
-        static = ops.concatenate((self.visible_bias, self.hidden_bias))
+        Each adds ``values @ group.T`` to ``[c_hat, b_hat]``, and its
+        statistic in :meth:`cd_statistics` is that of the group.  The
+        history (through ``dynamic``) and the context (through
+        ``context_weights``), those the layer has.
+        """
+        inputs = []
+        if self.n_lags:
+            inputs.append(("dynamic", history))
+        if self.n_context:
+            inputs.append(("context_weights", context))
+        return inputs
+
+    def frame_invariants(self):
         std = self.visible_std
-        input_weights = self.weights if std is None else self.weights / std
+        return {
+            "static": self.ops.concatenate((self.visible_bias, self.hidden_bias)),
+            "std": std,
+            "input_weights": self.weights if std is None else self.weights / std,
+        }
 
-        def frame_rbms(history, context=None):
-            visible_bias, hidden_bias = self.dynamic_biases(history, static=static)
-            return CRBMFrames(
-                visible_bias, hidden_bias, std, self.binary, self.weights, input_weights
-            )
-
-        return frame_rbms
+    def build_frame_rbms(self, invariants, history, context=None, *, out=None):
+        visible_bias, hidden_bias = self.dynamic_biases(
+            history, context, out=out, static=invariants["static"]
+        )
+        return CRBMFrames(
+            visible_bias,
+            hidden_bias,
+            invariants["std"],
+            self.visible_units,
+            self.weights,
+            invariants["input_weights"],
+            frame_invariant=self.n_lags == 0 and self.n_context == 0,
+        )
 
     # ------------------------------------------------------------ training
 
@@ -360,8 +435,8 @@ class CRBMLayer(ConditionalLayer):
         change of the visible mean (Montavon & Müller's centring, Cho, Raiko
         & Ilin's enhanced gradient).
 
-        ``context`` goes to :meth:`frame_rbms` (which ignores it: a CRBM has
-        no context).
+        Every input of the dynamic biases (:meth:`bias_inputs`: the
+        history, the context) has the statistic ``delta.T @ input``.
         """
         n, d = visible.shape
         ops = self.ops
@@ -440,10 +515,10 @@ class CRBMLayer(ConditionalLayer):
         bias_sums = ops.dot(workspace.ones[:n], delta, out=workspace.bias_sums)
         out.visible_bias[...] = bias_sums[:d]
         out.hidden_bias[...] = bias_sums[d:]
-        if self.n_lags:
-            ops.matmul(delta.T, history, out=out.dynamic)
-            if workspace.dynamic_mask is not None:
-                out.dynamic *= workspace.dynamic_mask
+        for name, values in self.bias_inputs(history, context):
+            ops.matmul(delta.T, values, out=getattr(out, name))
+        if workspace.dynamic_mask is not None:
+            out.dynamic *= workspace.dynamic_mask
         return out, squared_error
 
     def _centre_statistics(self, std, visible_bias, delta, d, scale, out):
@@ -480,11 +555,12 @@ def shift_centred(layer, direction):
     """Move ``layer`` in place to centred coordinates (``+1``) or back (``-1``).
 
     In centred coordinates the hidden units see the residual against the
-    dynamic visible bias, ``b' + B' x_past + W ((v - c_hat) / s)``: the same
-    model as the standard form ``b + B x_past + W (v / s)`` with ``b = b' -
-    W (c / s)`` and ``B_q = B'_q - W diag(1 / s) A_q``, where ``c`` and
-    ``A`` are the static visible bias and the autoregressive weights.
-    Needs ``hidden_order >= order``.
+    dynamic visible bias, ``b' + B' x_past + L'_h y + W ((v - c_hat) / s)``:
+    the same model as the standard form ``b + B x_past + L_h y + W (v / s)``
+    with ``b = b' - W (c / s)``, ``B_q = B'_q - W diag(1 / s) A_q`` and
+    ``L_h = L'_h - W diag(1 / s) L_v``, where ``c``, ``A`` and ``L_v`` are
+    the static visible bias, the autoregressive and the context-to-visible
+    weights.  Needs ``hidden_order >= order``.
     """
     ops = layer.ops
     n = layer.n_features
@@ -497,6 +573,11 @@ def shift_centred(layer, direction):
     if width:
         shift = ops.matmul(weights, layer.dynamic[:n, :width])
         layer.dynamic[n:, :width] = layer.dynamic[n:, :width] + direction * shift
+    if layer.n_context:
+        shift = ops.matmul(weights, layer.context_weights[:n, ...])
+        layer.context_weights[n:, ...] = layer.context_weights[n:, ...] + (
+            direction * shift
+        )
     return layer
 
 

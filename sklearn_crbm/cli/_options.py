@@ -1,12 +1,12 @@
-"""The command line's commands and their arguments (see :mod:`._cli`)."""
+"""The command line's commands and their arguments (see :mod:`._main`)."""
 
 import argparse
 import math
 import tempfile
 from pathlib import Path
 
-from ._crbm import ConditionalRBM
-from ._factored import FactoredCRBM
+from .._crbm import ConditionalRBM
+from .._factored import FactoredCRBM
 
 __all__ = ["COMMANDS", "DEMO_OUTPUT", "STYLES_OUTPUT"]
 

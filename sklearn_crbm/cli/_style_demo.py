@@ -14,13 +14,13 @@ import time
 import numpy as np
 import sklearn
 
+from ..datasets import bone_columns
+from ..metrics import StyleJudge
+from ..metrics._style import _nanmedian
+from ..plotting import plot_motion_strip, plot_style_probabilities
+from ..plotting._base import check_matplotlib
+from ..preprocessing import make_motion_pipeline
 from ._demo import GIF_FRAMES, GIF_STEP, _save, save_gif
-from .datasets import bone_columns
-from .metrics import StyleJudge
-from .metrics._style import _nanmedian
-from .plotting import plot_motion_strip, plot_style_probabilities
-from .plotting._base import check_matplotlib
-from .preprocessing import make_motion_pipeline
 
 __all__ = ["run_styles", "style_requests"]
 

@@ -1,6 +1,6 @@
 """Storage of a layer's trainable arrays in one flat buffer, and their updates.
 
-A conditional layer (:mod:`sklearn_crbm._layer`) lists its trainable arrays
+A conditional layer (:mod:`sklearn_crbm.layers`) lists its trainable arrays
 as :class:`ParameterGroup` entries; :class:`PackedParameters` lays them out
 in one flat buffer and gives each a view.  Weight decay is then one pass
 over a prefix of the buffer, a momentum step (:class:`MomentumUpdate`) one
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .utils._array_api import array_ops, copy_array
+from ..utils._array_api import array_ops, copy_array
 
 __all__ = [
     "MomentumUpdate",
