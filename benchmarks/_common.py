@@ -329,21 +329,25 @@ def _code(path):
     return ast.dump(tree)
 
 
-def cached_fit(model, X, sequence_ids):
+def cached_fit(model, X, sequence_ids, **fit_params):
     """``(fitted model, fit seconds)``, read from the cache when it is there.
 
-    The key is the model's class and parameters, the data and the package's
-    code (:func:`model_code_digest`), so changed code fits again.
+    The key is the model's class and parameters, the data (with the arrays
+    in ``fit_params``, such as ``context``) and the package's code
+    (:func:`model_code_digest`), so changed code fits again.
     """
     key = hashlib.sha1(model_code_digest().encode())
     key.update(type(model).__name__.encode())
     key.update(repr(sorted(model.get_params().items())).encode())
     key.update(np.ascontiguousarray(X).tobytes())
     key.update(np.ascontiguousarray(sequence_ids).tobytes())
+    for name, value in sorted(fit_params.items()):
+        key.update(name.encode() + np.ascontiguousarray(value).tobytes())
     path = CACHE / f"{type(model).__name__}_{key.hexdigest()[:24]}.joblib"
     if path.exists():
         return joblib.load(path)
-    result = (model, seconds(partial(model.fit, X, sequence_ids=sequence_ids)))
+    fit = partial(model.fit, X, sequence_ids=sequence_ids, **fit_params)
+    result = (model, seconds(fit))
     path.parent.mkdir(parents=True, exist_ok=True)
     joblib.dump(result, path)
     return result

@@ -496,6 +496,9 @@ def test_fetch_downloads_the_data_sets_asked_for(tmp_path, capsys, monkeypatch):
         (["fit", "--order", "x"], "argument --order: must be a whole number, got 'x'"),
         (["styles", "--n-sequences", "0"], "argument --n-sequences: must be at"),
         (["fit", "--frame-rate", "-1"], "argument --frame-rate: must be positive"),
+        (["sample", "m.joblib", "--speed", "fast"], "argument --speed: must be a"),
+        (["sample", "m.joblib", "--speed", "1:2:3"], "argument --speed: must be a"),
+        (["sample", "m.joblib", "--speed", "nan"], "argument --speed: must be fin"),
     ],
 )
 def test_bad_counts_are_named_by_their_flags(argv, message, capsys):
@@ -573,3 +576,71 @@ def test_styles_runs_on_a_users_labelled_folder(tmp_path, capsys):
         assert (output / f"{name}.png").stat().st_size > 1000
     assert Image.open(output / "styles.gif").n_frames == 60
     assert Image.open(output / "transition_fast_odd.gif").n_frames == 60
+
+
+# -- speed as context (issue 36) ----------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def speed_model(tmp_path_factory):
+    """A model fitted on walks of different speeds with ``--speed-context``."""
+    tmp_path = tmp_path_factory.mktemp("speed")
+    folder = _walker_folder(tmp_path / "mine", 30.0, n_frames=60)
+    model = tmp_path / "m.joblib"
+    output = io.StringIO()
+    with redirect_stdout(output):
+        status = main(
+            ["fit", str(folder), "--speed-context", *TINY, "--output", str(model)]
+        )
+    assert status == 0
+    return model, output.getvalue(), folder
+
+
+def test_fit_speed_context_saves_the_speed_measure_and_scaler(speed_model):
+    model, report, folder = speed_model
+    saved = _cli._load_model(model)
+    assert saved.pipeline[-1].n_context_ == 1
+    assert list(saved.speed.get_feature_names_out()) == ["forward_speed"]
+    data = _cli._read_motion_folder(folder)
+    speeds = saved.speed.transform(data.data, sequence_ids=data.sequence_ids)
+    assert_array_equal(saved.speed_scaler.mean_, speeds.mean(axis=0))
+    low, high = speeds.min(), speeds.max()
+    assert f"forward speed as context: {low:.1f} to {high:.1f} length units" in report
+
+
+def test_sample_speed_is_every_frames_context(speed_model):
+    model = speed_model[0]
+    saved = _cli._load_model(model)
+    args = argparse.Namespace(model=model, speed=(15.0, 21.0), n_frames=7)
+    context = _cli._speed_request(saved, args)["context"]
+    expected = saved.speed_scaler.transform(np.linspace(15.0, 21.0, 7)[:, None])
+    assert_array_equal(context, expected)
+    parsed = _cli._parser().parse_args(["sample", "m", "--speed", "40"]).speed
+    assert parsed == (40.0, 40.0)
+
+
+def test_sample_generates_at_the_speed_asked(speed_model, tmp_path, capsys):
+    model = speed_model[0]
+    frames = {}
+    for name, speed in [("a", "15"), ("b", "15"), ("c", "21"), ("d", "15:21")]:
+        prefix = tmp_path / name
+        argv = ["sample", str(model), "--speed", speed, "--n-frames", "12"]
+        assert main([*argv, "--output", str(prefix)]) == 0
+        assert re.search(r"forward speed -?\d+\.\d\)", capsys.readouterr().out)
+        frames[name] = read_bvh(f"{prefix}_0.bvh")[1]
+    assert_array_equal(frames["a"], frames["b"])
+    assert not np.allclose(frames["a"], frames["c"])
+    assert not np.allclose(frames["a"], frames["d"])
+
+
+def test_sample_speed_needs_a_model_fitted_with_it(speed_model, tmp_path, capsys):
+    model = speed_model[0]
+    assert main(["sample", str(model), "--output", str(tmp_path / "x")]) == 1
+    assert "was fitted with speed as context: give --speed" in capsys.readouterr().err
+    folder = _walker_folder(tmp_path / "mine", 30.0, n_frames=30)
+    plain = tmp_path / "plain.joblib"
+    assert main(["fit", str(folder), *TINY, "--output", str(plain)]) == 0
+    argv = ["sample", str(plain), "--speed", "20", "--output", str(tmp_path / "y")]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert "fitted without speed as context: fit it with --speed-context" in err

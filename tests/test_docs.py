@@ -137,6 +137,7 @@ def test_docs_build(html_dir):
         "scaling",
         "labelled_motion",
         "styles",
+        "control",
     ]:
         assert (html_dir / "user_guide" / f"{page}.html").is_file(), page
 

@@ -15,6 +15,7 @@ from pathlib import Path
 import joblib
 import numpy as np
 import sklearn
+from sklearn.preprocessing import StandardScaler
 from sklearn.utils import Bunch
 
 from .._base import generated_liveliness
@@ -31,7 +32,7 @@ from ..datasets import (
     read_bvh_folder,
     resample_frames,
 )
-from ..preprocessing import MotionPipeline, make_motion_pipeline
+from ..preprocessing import MotionContext, MotionPipeline, make_motion_pipeline
 from ._demo import liveliness_text, save_gif
 from ._demo import run_demo as _run_demo
 from ._options import COMMANDS, MAX_DEFAULT_RATE
@@ -153,7 +154,11 @@ def run_fit(args):
     )
     _check_order(args.order, data)
     pipeline = make_motion_pipeline(data.skeleton, _model_from_args(args))
-    pipeline.fit(data.data, sequence_ids=data.sequence_ids)
+    speed = _speed_context(data, styles) if args.speed_context else {}
+    context = {}
+    if speed:
+        context["context"] = speed["speed_scaler"].transform(speed.pop("speeds"))
+    pipeline.fit(data.data, sequence_ids=data.sequence_ids, **context)
     windows = {}
     if styles is not None:
         windows = pipeline.style_windows(
@@ -163,10 +168,36 @@ def run_fit(args):
             n_windows=N_STYLE_WINDOWS,
             random_state=args.seed,
         )
-    saved = Bunch(pipeline=pipeline, seed_windows=windows, frame_rate=data.frame_rate)
+    saved = Bunch(
+        pipeline=pipeline, seed_windows=windows, frame_rate=data.frame_rate, **speed
+    )
     joblib.dump(dict(saved), args.output)
     print(f"saved the fitted pipeline to {args.output}")
     return 0
+
+
+def _speed_context(data, styles):
+    """``fit --speed-context``: the fitted speed measure, its scaler, the speeds.
+
+    Prints the range of the training speeds (and each style's mean), the
+    speeds ``sample --speed`` can ask for with confidence.
+    """
+    speed = MotionContext(
+        data.skeleton, signals=["forward_speed"], frame_rate=data.frame_rate
+    )
+    speeds = speed.fit_transform(data.data, sequence_ids=data.sequence_ids)
+    means = ""
+    if styles is not None:
+        means = ", ".join(
+            f"{style} {speeds[styles == style].mean():.1f}"
+            for style in dict.fromkeys(styles)
+        )
+        means = f" (mean: {means})"
+    print(
+        f"forward speed as context: {speeds.min():.1f} to {speeds.max():.1f} "
+        f"length units per second{means}"
+    )
+    return dict(speed=speed, speed_scaler=StandardScaler().fit(speeds), speeds=speeds)
 
 
 def _training_data(args):
@@ -292,15 +323,17 @@ def run_sample(args):
         n_sequences=args.n_sequences,
         hidden_noise=args.hidden_noise,
         random_state=args.seed,
+        **_speed_request(saved, args),
     )
     suffixes = [".bvh"] + [".amc"] * (pipeline.skeleton.convention == "acclaim")
     lively = _liveliness(pipeline, raw, args.n_frames)
     sequences = np.split(raw, args.n_sequences)
     for k, sequence in enumerate(sequences):
+        measured = _speed_text(saved, sequence)
         for suffix in suffixes:
             path = Path(f"{args.output}_{k}{suffix}")
             pipeline.write_motion(path, sequence, frame_rate=saved.frame_rate)
-            print(f"wrote {path} ({liveliness_text(lively[k])})")
+            print(f"wrote {path} ({liveliness_text(lively[k])}{measured})")
     if args.animate:
         path = save_gif(
             Path(f"{args.output}.gif"),
@@ -311,6 +344,33 @@ def run_sample(args):
         )
         print(f"wrote {path}")
     return 0
+
+
+def _speed_request(saved, args):
+    """``sample``'s context for ``--speed``: ``{}`` for a model without one."""
+    scaler = saved.get("speed_scaler")
+    if scaler is None:
+        if args.speed is not None:
+            raise ValueError(
+                f"{args.model} was fitted without speed as context: fit it with "
+                "--speed-context to generate at a --speed."
+            )
+        return {}
+    if args.speed is None:
+        raise ValueError(
+            f"{args.model} was fitted with speed as context: give --speed (its "
+            f"training frames move at {scaler.mean_[0]:.1f} length units per "
+            "second on average)."
+        )
+    requested = np.linspace(*args.speed, args.n_frames)[:, None]
+    return {"context": scaler.transform(requested)}
+
+
+def _speed_text(saved, sequence):
+    """``", forward speed 40.2"`` for a model fitted with speed; else ``""``."""
+    if "speed" not in saved:
+        return ""
+    return f", forward speed {saved.speed.transform(sequence).mean():.1f}"
 
 
 def _liveliness(pipeline, raw, n_frames):

@@ -62,6 +62,23 @@ _rate = _checked(
 )
 
 
+def _speed_request(text):
+    """``--speed``: ``SPEED`` or a ramp ``FROM:TO``, as ``(from, to)``."""
+    parts = text.split(":")
+    try:
+        if len(parts) > 2:
+            raise ValueError
+        start, stop = (float(part) for part in (parts * 2)[:2])
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"must be a speed (40) or a ramp from one speed to another (20:60), "
+            f"got {text!r}"
+        ) from None
+    if not (math.isfinite(start) and math.isfinite(stop)):
+        raise argparse.ArgumentTypeError(f"must be finite, got {text}")
+    return start, stop
+
+
 # A folder's motion is trained at its files' own rate, but at most this many
 # frames per second (the paper's 30; CMU's AMC files are 120).
 MAX_DEFAULT_RATE = 30.0
@@ -233,8 +250,10 @@ COMMANDS = {
         "them with joblib for the sample command. The file holds a dict: "
         "'pipeline' (a fitted sklearn_crbm.preprocessing.MotionPipeline), "
         "'seed_windows' (real frames of each style: CMU 35's walk and jog, "
-        "or the labels of --labels) and "
-        "'frame_rate'.",
+        "or the labels of --labels), "
+        "'frame_rate' and, with --speed-context, 'speed' (the fitted "
+        "MotionContext) and 'speed_scaler' (the StandardScaler of its "
+        "output that gives the model its context).",
         [
             _option(
                 "folder",
@@ -253,6 +272,13 @@ COMMANDS = {
                 "style_label.txt when there is one), or a regular expression "
                 "with a group, matched against each file's name "
                 "('walk_([a-z]+)_' labels walk_proud_01.bvh 'proud')",
+            ),
+            _option(
+                "--speed-context",
+                action="store_true",
+                help="train with every frame's forward speed as the model's "
+                "context (MotionContext, 1-s window, z-scored), so that "
+                "'sample --speed' can ask for a speed",
             ),
             *_MODEL_OPTIONS,
             _option(
@@ -276,6 +302,14 @@ COMMANDS = {
                 help="seed each sequence with real frames of this style ('walk' "
                 "or 'jog' for CMU 35); default: the model's own seed windows, "
                 "from every training sequence",
+            ),
+            _option(
+                "--speed",
+                type=_speed_request,
+                help="forward speed to generate at, in the training data's length "
+                "units per second: SPEED for every frame, or FROM:TO for a "
+                "steady change over the frames (20:60 speeds a CMU 35 walk up "
+                "into a jog); for a model fitted with --speed-context",
             ),
             _N_FRAMES,
             _option(
