@@ -218,19 +218,50 @@ class BaseCRBM(
     def _fit_context(self, X, y, context, reset):
         """Every frame's context in ``fit`` and ``score``: from ``y`` or ``context``."""
         labels = self._labels_context(y, X, reset)
+        if reset:
+            self._forget_context_scaling()
         if labels is None:
             if reset:
-                return check_context(context, X.shape[0], None, X)
+                context = check_context(context, X.shape[0], None, X)
+                self._learn_context_scaling(context)
+                return self._standardized(context)
             if context is None and self.n_context_:
                 raise self._missing_context_error()
-            return check_context(context, X.shape[0], self.n_context_, X)
+            context = check_context(context, X.shape[0], self.n_context_, X)
+            return self._standardized(context)
         if context is not None:
             raise self._both_error("y")
         return labels
 
     def _score_context(self, X, y, context):
         """Every frame's context in ``score``, whose ``y`` only style models read."""
-        return check_context(context, X.shape[0], self.n_context_, X)
+        context = check_context(context, X.shape[0], self.n_context_, X)
+        return self._standardized(context)
+
+    # A real-valued context is standardised, as X is by the default
+    # preprocessing: the learning rate and the initial weights assume inputs
+    # of unit scale, and a control in the data's units (a speed in
+    # centimetres per second) would swamp the past's input to the hidden units.
+    def _learn_context_scaling(self, context):
+        if context is None or not getattr(self, "_scales_context", True):
+            return
+        ops = array_ops(context)
+        self.context_mean_ = ops.mean(context, axis=0)
+        scale = ops.std(context, axis=0)
+        self.context_scale_ = ops.where(scale > 0, scale, ops.ones_like(scale))
+
+    def _forget_context_scaling(self):
+        vars(self).pop("context_mean_", None)
+        vars(self).pop("context_scale_", None)
+
+    def _standardized(self, context):
+        """A user's real-valued context as the layers see it (labels: unchanged)."""
+        if context is None or "context_mean_" not in vars(self):
+            return context
+        ops = array_ops(context)
+        mean = ops.astype(self.context_mean_, context.dtype, copy=False)
+        scale = ops.astype(self.context_scale_, context.dtype, copy=False)
+        return (context - mean) / scale
 
     def _both_error(self, labels):
         return ValueError(
@@ -248,7 +279,10 @@ class BaseCRBM(
             if context is not None:
                 raise self._both_error("style=")
             return self._style_context(style, n_frames, like)
-        return check_context(context, n_frames, self.n_context_, like, one_row=one_row)
+        context = check_context(
+            context, n_frames, self.n_context_, like, one_row=one_row
+        )
+        return self._standardized(context)
 
     def _missing_context_error(self):
         k = self.n_context_

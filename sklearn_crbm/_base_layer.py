@@ -104,8 +104,11 @@ class BaseLayerModel(BaseCRBM):
             speed): :class:`~sklearn_crbm.ConditionalRBM` and
             :class:`~sklearn_crbm.LabelledCRBM` add it to their dynamic
             biases, :class:`~sklearn_crbm.FactoredCRBM` gates its factors
-            with it.  A model fitted with a context needs one in every
-            method that computes (``n_context_`` columns).  Not with ``y``.
+            with it.  The model standardises a real-valued context with the
+            mean and standard deviation of this call's (``context_mean_``,
+            ``context_scale_``), so it may be given in any unit.  A model
+            fitted with a context needs one in every method that computes
+            (``n_context_`` columns).  Not with ``y``.
 
         Returns
         -------

@@ -125,11 +125,19 @@ class ConditionalRBM(BaseLayerModel):
     visible_variance_ : ndarray of shape (n_features,)
         Variance of each Gaussian visible unit (ones for ``"unit"``).
     context_to_visible_ : ndarray of shape (n_features, n_context)
-        ``context_to_visible_ @ y_t`` adds to frame ``t``'s visible mean.
+        ``context_to_visible_ @ y_t`` adds to frame ``t``'s visible mean, with
+        ``y_t`` the standardised context (``context_mean_``, ``context_scale_``).
     context_to_hidden_ : ndarray of shape (n_components, n_context)
         ``context_to_hidden_ @ y_t`` adds to frame ``t``'s hidden input.
     n_context_ : int
         Columns of the context the model was fitted with (0: none).
+    context_mean_ : ndarray of shape (n_context,)
+        Mean of each column of a real-valued context in ``fit``, which the
+        model subtracts from every context it is given (absent when fitted
+        without one).
+    context_scale_ : ndarray of shape (n_context,)
+        Standard deviation of each column (1 for a constant one), by which
+        the model divides every context it is given.
     seed_windows_ : ndarray of shape (n_windows, width, n_features)
         Windows of consecutive training frames that seed :meth:`sample`.
     reconstruction_error_ : float

@@ -79,6 +79,13 @@ class LabelledCRBM(BaseStyleModel):
     n_context_ : int
         Columns of the context: the number of styles for a model fitted on
         labels.
+    context_mean_ : ndarray of shape (n_context,)
+        Mean of each column of a real-valued context in ``fit``, which the
+        model subtracts from every context it is given (absent when fitted
+        without one or on labels).
+    context_scale_ : ndarray of shape (n_context,)
+        Standard deviation of each column (1 for a constant one), by which
+        the model divides every context it is given.
     seed_windows_ : ndarray of shape (n_windows, width, n_features)
     reconstruction_error_ : float
     n_iter_ : int

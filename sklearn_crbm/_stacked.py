@@ -99,6 +99,13 @@ class StackedCRBM(BaseCRBM):
         The fitted layers, bottom (Gaussian visibles) first.
     n_context_ : int
         Columns of the context the stack was fitted with (0: none).
+    context_mean_ : ndarray of shape (n_context,)
+        Mean of each column of a real-valued context in ``fit``, which the
+        model subtracts from every context it is given (absent when fitted
+        without one).
+    context_scale_ : ndarray of shape (n_context,)
+        Standard deviation of each column (1 for a constant one), by which
+        the model divides every context it is given.
     seed_windows_ : ndarray of shape (n_windows, history_length, n_features)
         Windows of consecutive training frames kept to seed :meth:`sample`.
     random_state_ : RandomState instance
@@ -251,18 +258,22 @@ class StackedCRBM(BaseCRBM):
     def _new_layer(self, n_components, visible_type, seed, history_noise):
         if self.estimator is None:
             params = self.get_params(deep=False)
-            return ConditionalRBM(
+            layer = ConditionalRBM(
                 n_components,
                 visible_type=visible_type,
                 history_noise=history_noise,
                 random_state=seed,
                 **{name: params[name] for name in self._layer_parameters},
             )
-        layer = clone(self.estimator)
-        own = dict(n_components=n_components, random_state=seed)
-        if "visible_type" in layer.get_params(deep=False):
-            own["visible_type"] = visible_type
-        return layer.set_params(**own)
+        else:
+            layer = clone(self.estimator)
+            own = dict(n_components=n_components, random_state=seed)
+            if "visible_type" in layer.get_params(deep=False):
+                own["visible_type"] = visible_type
+            layer.set_params(**own)
+        # the stack standardises a real-valued context once, for every layer
+        layer._scales_context = False
+        return layer
 
     def _check_fit_input(self, X, sequence_ids, context, reset):
         xp = get_namespace(X)[0]

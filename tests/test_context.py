@@ -67,7 +67,10 @@ def test_the_context_adds_to_the_dynamic_biases(fitted):
     before = model.transform(X, sequence_ids=ids, context=context)
     model.context_to_hidden_ = L_h
     after = model.transform(X, sequence_ids=ids, context=context)
-    assert_allclose(logit(after) - logit(before), context @ L_h.T, atol=1e-8)
+    # the model standardises the context it is given
+    z = (context - model.context_mean_) / model.context_scale_
+    assert_allclose(z.mean(axis=0), 0, atol=1e-12)
+    assert_allclose(logit(after) - logit(before), z @ L_h.T, atol=1e-8)
     # one step of prediction from the past alone, without hidden units:
     # the visible bias moves by L_v y
     model.components_ = np.zeros_like(model.components_)
@@ -76,7 +79,27 @@ def test_the_context_adds_to_the_dynamic_biases(fitted):
     still = model.predict_next(X, sequence_ids=ids, context=context)
     model.context_to_visible_ = L_v
     moved = model.predict_next(X, sequence_ids=ids, context=context)
-    assert_allclose(moved - still, context @ L_v.T, atol=1e-10)
+    assert_allclose(moved - still, z @ L_v.T, atol=1e-10)
+
+
+def test_the_context_may_be_given_in_any_unit(fitted):
+    """A control in other units (a speed in cm/s, not m/s) trains the same model."""
+    X, ids, context = driven_data()
+    rescaled = 100.0 * context + [5.0, -40.0]
+    model = small_model(n_iter=200).fit(X, sequence_ids=ids, context=rescaled)
+    assert_allclose(model.context_mean_, 100.0 * fitted.context_mean_ + [5, -40])
+    assert_allclose(model.context_scale_, 100.0 * fitted.context_scale_)
+    assert_allclose(model._layer.flat, fitted._layer.flat, rtol=1e-6, atol=1e-9)
+    assert_allclose(
+        model.score_samples(X, sequence_ids=ids, context=rescaled),
+        fitted.score_samples(X, sequence_ids=ids, context=context),
+        rtol=1e-6,
+    )
+    # a constant column is centred, not divided by zero
+    constant = np.hstack([context, np.full((len(X), 1), 3.0)])
+    model = small_model().fit(X, sequence_ids=ids, context=constant)
+    assert model.context_scale_[2] == 1.0
+    assert np.all(np.isfinite(model.transform(X, sequence_ids=ids, context=constant)))
 
 
 def test_it_learns_what_the_context_says(fitted):

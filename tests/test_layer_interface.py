@@ -260,7 +260,12 @@ def test_it_scores_exactly():
     model.fit(X, sequence_ids=ids, context=context)
     layer = model._layer
     layer.flat[...] = 0.3 * np.random.default_rng(0).standard_normal(layer.flat.size)
-    expected = exact_log_likelihood(layer, X, ids, context)
+
+    # the estimator gives its layer the standardised context
+    def standardised(context):
+        return (context - model.context_mean_) / model.context_scale_
+
+    expected = exact_log_likelihood(layer, X, ids, standardised(context))
     got = model.score_samples(X, sequence_ids=ids, context=context)
     assert_allclose(got, expected, rtol=1e-9, atol=1e-9)
     estimate = model.estimate_log_likelihood(
@@ -268,7 +273,7 @@ def test_it_scores_exactly():
     )
     assert_allclose(estimate.log_likelihood, expected, rtol=1e-9, atol=1e-9)
     # another context, another likelihood: exactly that of the energy
-    other = exact_log_likelihood(layer, X, ids, -context)
+    other = exact_log_likelihood(layer, X, ids, standardised(-context))
     assert_allclose(
         model.score_samples(X, sequence_ids=ids, context=-context), other, rtol=1e-9
     )
