@@ -160,8 +160,9 @@ def _model_outputs(model, X, ids, styles=None):
     models define them; generation takes the first and the last style.
     """
     given = () if styles is None else (styles,)
+    # the stored outputs were drawn with one mean-field step, the default then
     first, last = (
-        ({}, {})
+        ({"n_mean_field": 1}, {"n_mean_field": 1})
         if styles is None
         else (
             {"style": model.classes_[0]},

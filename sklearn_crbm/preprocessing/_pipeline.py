@@ -197,7 +197,8 @@ class MotionPipeline(Pipeline):
         **params : dict
             Passed on to the model's ``sample`` (for a
             :class:`~sklearn_crbm.ConditionalRBM`: ``n_gibbs``,
-            ``hidden_noise``, ``sample_visibles``, ``n_jobs``).
+            ``hidden_noise``, ``sample_visibles``, ``n_mean_field``,
+            ``n_jobs``).
 
         Returns
         -------
