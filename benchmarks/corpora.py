@@ -15,6 +15,9 @@ normal style, takes 001-012 of each of ten contents) and per training seed
 
   - *liveliness*: ``metrics.liveliness`` of the 12 most-moving joint angles
     (1 = as lively as the real takes);
+  - *liveliness in the cycle*: the same against the middle halves of the
+    real takes only (the cycle itself: a take of waving raises the arms
+    before it and lowers them after, which the whole takes' motion counts);
   - *frequency*: ``metrics.step_frequency`` of those channels, over the mean
     of the real takes';
   - *blown*: sequences with a value beyond |z| = 10, or non-finite;
@@ -34,6 +37,7 @@ Run from the repository root (fitted models are cached)::
 
     python benchmarks/corpora.py
     python benchmarks/corpora.py --contents run wave-both-hands --seeds 0 1
+    python benchmarks/corpora.py --sample '{"n_mean_field": 1}'  # original sampler
 """
 
 import json
@@ -110,8 +114,11 @@ class Content:
         )
 
     def unscaled(self, Z):
-        """The joint angles and root channels, in their units (before scaling)."""
-        return self.preprocessor[-1].inverse_transform(Z)
+        """The joint angles and root channels, in their units (before scaling),
+        in the columns of ``Z`` (the scaler's inverse also restores the
+        constant channels it dropped)."""
+        scaler = self.preprocessor[-1]
+        return scaler.inverse_transform(Z)[:, ~scaler.constant_mask_]
 
     def positions(self, raw):
         return self.skeleton.forward_kinematics(raw)
@@ -134,14 +141,24 @@ class Content:
             windows.append(self.Z[end - width + 1 : end + 1])
         return np.stack(windows)
 
+    def cycle(self):
+        """Rows of the middle half of every take (the cycle, without the rest
+        or the transitions at its ends)."""
+        ids = self.takes.sequence_ids
+        rows = [np.flatnonzero(ids == take) for take in np.unique(ids)]
+        return np.concatenate([r[len(r) // 4 : 3 * len(r) // 4] for r in rows])
 
-def judge(content, model, seed):
-    """Every statistic of the sequences that ``model`` generates."""
+
+def judge(content, model, seed, sample_params=None):
+    """Every statistic of the sequences that ``model`` generates (``sample``
+    given ``sample_params``)."""
     pipeline = MotionPipeline([*content.preprocessor.steps, ("model", model)])
     history = content.seeds(max(model.history_length, 1))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", GenerationWarning)
-        Z = model.sample(N_FRAMES, history=history, random_state=seed)
+        Z = model.sample(
+            N_FRAMES, history=history, random_state=seed, **(sample_params or {})
+        )
     ids = np.repeat(np.arange(N_SEQUENCES), N_FRAMES)
     judged = np.tile(np.arange(N_FRAMES), N_SEQUENCES)
     judged = (judged >= JUDGED.start) & (judged < JUDGED.stop)
@@ -149,13 +166,17 @@ def judge(content, model, seed):
     with sklearn.config_context(enable_metadata_routing=True):
         raw = pipeline[:-1].inverse_transform(Z, sequence_ids=ids)
     positions = content.positions(raw)[judged]
-    lively = liveliness(
-        unscaled[judged],
-        content.unscaled_real,
-        sequence_ids=ids[judged],
-        reference_sequence_ids=content.takes.sequence_ids,
-        n_channels=N_CHANNELS,
-        features=content.angles,
+    cycle = content.cycle()
+    lively, lively_in_cycle = (
+        liveliness(
+            unscaled[judged],
+            content.unscaled_real[rows],
+            sequence_ids=ids[judged],
+            reference_sequence_ids=content.takes.sequence_ids[rows],
+            n_channels=N_CHANNELS,
+            features=content.angles,
+        )
+        for rows in (slice(None), cycle)
     )
     finite = np.isfinite(Z).all(axis=1)
     per_sequence = np.abs(np.where(finite[:, None], Z, np.inf)).reshape(
@@ -163,6 +184,7 @@ def judge(content, model, seed):
     )
     statistics = dict(
         liveliness=lively,
+        cycle_liveliness=lively_in_cycle,
         frequency=content.frequency(unscaled[judged], ids[judged])
         / content.real["frequency"],
         blown=(per_sequence.max(axis=(1, 2)) > BLOWN_Z).astype(float),
@@ -176,7 +198,7 @@ def judge(content, model, seed):
     return {key: np.asarray(value).tolist() for key, value in statistics.items()}
 
 
-STATISTICS = ("liveliness", "frequency", "jitter", "skating")
+STATISTICS = ("liveliness", "cycle_liveliness", "frequency", "jitter", "skating")
 
 
 def _warned(caught):
@@ -214,9 +236,11 @@ def main(argv=None):
     p = parser(__doc__)
     p.add_argument("--contents", nargs="+", default=list(CYCLIC + ONE_SHOT))
     p.add_argument("--model", default="{}", help="ConditionalRBM parameters, JSON")
+    p.add_argument("--sample", default="{}", help="sample's parameters, JSON")
     args = p.parse_args(argv)
     announce()
     model_params = json.loads(args.model)
+    sample_params = json.loads(args.sample)
     rows, runs = [], {}
     for name in args.contents:
         content = Content(args.data_home, name)
@@ -228,7 +252,7 @@ def main(argv=None):
                 model, fit_seconds = cached_fit(
                     model, content.Z, content.takes.sequence_ids
                 )
-                run = judge(content, model, seed)
+                run = judge(content, model, seed, sample_params)
             run.update(seed=seed, fit_seconds=fit_seconds, n_iter=model.n_iter_)
             runs[name].append(run)
             print(
@@ -246,6 +270,7 @@ def main(argv=None):
         "content",
         "seeds",
         ("liveliness", "liveliness [95%]", "s"),
+        ("cycle_liveliness", "in the cycle [95%]", "s"),
         ("frequency", "frequency / real [95%]", "s"),
         ("blown", "blown", "d"),
         ("jitter", "jitter / real [95%]", "s"),

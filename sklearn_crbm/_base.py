@@ -740,6 +740,7 @@ n_classes), default=None
         n_gibbs=None,
         hidden_noise=0.0,
         sample_visibles=False,
+        n_mean_field=10,
         random_state=None,
         n_jobs=None,
     ):
@@ -747,12 +748,12 @@ n_classes), default=None
 
         Each new frame starts from the previous frame plus N(0, 0.01^2)
         jitter; ``n_gibbs`` alternating Gibbs iterations follow (hidden units
-        sampled, visibles set to their mean), then one mean-field step with
-        hidden probabilities.  All sequences are generated together.  A
-        stack does this in its top layer, whose visible units are the hidden
-        probabilities of the layer below, and each layer below turns them
-        into its visible means given its own generated past, down to the
-        data (Taylor's ``gen2.m``).
+        sampled, visibles set to their mean), then ``n_mean_field``
+        mean-field steps (hidden probabilities, visible means).  All
+        sequences are generated together.  A stack does this in its top
+        layer, whose visible units are the hidden probabilities of the layer
+        below, and each layer below turns them into its visible means given
+        its own generated past, down to the data (Taylor's ``gen2.m``).
 
         Parameters
         ----------
@@ -791,8 +792,14 @@ default=None
             or binary states) and each new frame is the last draw: an exact
             Gibbs sampler whose frames follow ``p(x_t | history)`` when
             ``n_gibbs`` is large.  The default keeps the original code's
-            scheme (visible means, then a mean-field step), which gives
-            smoother motion.
+            scheme (visible means, then mean field), which gives smoother
+            motion.
+        n_mean_field : int, default=10
+            Mean-field steps that end each frame (ignored with
+            ``sample_visibles``).  The original code takes one, which leaves
+            the frame where the last sampled hidden states put it, and the
+            frames shake; further steps settle it at the mean-field fixed
+            point of the mode the chain ended in.
         random_state : int, RandomState instance or None, default=None
             Seeds the generation; ``None`` uses the estimator's
             ``random_state``, so repeated calls give the same frames when
@@ -818,6 +825,7 @@ default=None
             n_gibbs = self.get_params().get("n_gibbs", DEFAULT_N_GIBBS)
         n_gibbs = check_count(n_gibbs, "n_gibbs", minimum=0)
         n_sequences = check_count(n_sequences, "n_sequences", minimum=1)
+        n_mean_field = check_count(n_mean_field, "n_mean_field", minimum=1)
         if not isinstance(hidden_noise, Real) or not hidden_noise >= 0:
             raise ValueError(
                 f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
@@ -848,6 +856,7 @@ default=None
             n_gibbs=n_gibbs,
             hidden_noise=hidden_noise,
             sample_visibles=sample_visibles,
+            n_mean_field=n_mean_field,
             n_jobs=n_jobs,
         )
         self._check_generated(frames, n_samples)
@@ -872,7 +881,7 @@ default=None
         ``seed`` has shape ``(n_sequences, width, n_features)``; ``context``
         (shape ``(n_sequences, n_samples, n_context)``) gives each new frame's
         context to a layer that takes one.  ``gibbs`` holds ``n_gibbs``,
-        ``hidden_noise`` and ``sample_visibles``.
+        ``hidden_noise``, ``sample_visibles`` and ``n_mean_field``.
         """
         layers = self._layers()
         ops = layers[0].ops

@@ -114,18 +114,20 @@ def gibbs_frames(
     hidden_noise=0.0,
     observed_mask=None,
     sample_visibles=False,
+    n_mean_field=1,
 ):
     """Alternating Gibbs sampling of new frames given their frame RBMs.
 
     The original generation scheme: ``n_gibbs`` iterations in which the
-    hidden units are sampled and the visibles set to their mean, then one
-    final mean-field step with hidden probabilities.  ``hidden_noise`` adds
-    N(0, hidden_noise^2) to the hidden biases each time hidden states are
-    chosen (paper §4.3).  Where ``observed_mask`` is True the visibles stay
-    clamped at their value in ``start`` (paper §4.4).  With
-    ``sample_visibles=True`` the visibles are drawn from ``p(v | h, past)``
-    at every step and the last draw is returned (no mean-field step): an
-    exact Gibbs sampler of ``p(v_t | past)``.
+    hidden units are sampled and the visibles set to their mean, then
+    ``n_mean_field`` final mean-field steps with hidden probabilities (the
+    original code takes one).  ``hidden_noise`` adds N(0, hidden_noise^2)
+    to the hidden biases each time hidden states are chosen (paper §4.3).
+    Where ``observed_mask`` is True the visibles stay clamped at their value
+    in ``start`` (paper §4.4).  With ``sample_visibles=True`` the visibles
+    are drawn from ``p(v | h, past)`` at every step and the last draw is
+    returned (no mean-field step): an exact Gibbs sampler of ``p(v_t |
+    past)``.
 
     Parameters
     ----------
@@ -158,10 +160,11 @@ def gibbs_frames(
                 ops.copyto(visible, start, where=observed_mask)
     if sample_visibles:
         return visible
-    rbms.hidden_probabilities(visible, out=hidden)
-    rbms.visible_mean(hidden, out=visible)
-    if observed_mask is not None:
-        ops.copyto(visible, start, where=observed_mask)
+    for _ in range(n_mean_field):
+        rbms.hidden_probabilities(visible, out=hidden)
+        rbms.visible_mean(hidden, out=visible)
+        if observed_mask is not None:
+            ops.copyto(visible, start, where=observed_mask)
     return visible
 
 

@@ -303,6 +303,7 @@ def run_online(
     start_jitter=0.0,
     hidden_noise=0.0,
     sample_visibles=False,
+    n_mean_field=1,
     offset_shrinkage=None,
     observation_gain=1.0,
 ):
@@ -357,6 +358,9 @@ def run_online(
     sample_visibles : bool, default=False
         Draw the visibles at every step (:func:`gibbs_frames`); one layer,
         or the top layer with :data:`TOP_LAYER`.
+    n_mean_field : int, default=1
+        Mean-field steps that end each frame's Gibbs run in
+        :func:`gibbs_frames` (not with :data:`WHOLE_STACK` on a stack).
     offset_shrinkage : float, default=None
         Fill-in only.  ``None``: no correction.  A number ``lam >= 0``: each
         chain's drawn entries are shifted by the chain's :class:`Offsets`
@@ -412,6 +416,7 @@ def run_online(
                 hidden_noise=hidden_noise,
                 observed_mask=clamp,
                 sample_visibles=sample_visibles,
+                n_mean_field=n_mean_field,
             )
         ]
         for rbms in stack[-2::-1]:

@@ -447,13 +447,34 @@ def test_sample_follows_the_seed_dynamics():
     assert np.std(generated, axis=0).min() > 0.3  # keeps oscillating, does not die out
 
 
+def test_sample_settles_each_frame_by_mean_field():
+    """The default's mean-field steps take out the shake of the original one
+    step (jerk above the real sequences') and keep the oscillation."""
+    X, ids = make_oscillations(n_sequences=6, n_frames=80, n_features=5, random_state=0)
+    model = ConditionalRBM(30, order=3, n_iter=150, learning_rate=0.01, random_state=0)
+    model.fit(X, sequence_ids=ids)
+
+    def jerk(frames):
+        return np.abs(np.diff(frames, 3, axis=0)).mean()
+
+    original = model.sample(40, history=X[:3], n_mean_field=1, random_state=1)
+    settled = model.sample(40, history=X[:3], random_state=1)
+    assert jerk(original) > jerk(X[:80]) > 5 * jerk(settled)
+    assert np.std(settled, axis=0).min() > 0.3
+    assert_allclose(np.std(settled, axis=0), np.std(original, axis=0), rtol=0.05)
+    with pytest.raises(ValueError, match="n_mean_field must be an integer >= 1"):
+        model.sample(3, n_mean_field=0)
+
+
 def test_hidden_noise_changes_samples():
     X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
     model = ConditionalRBM(8, order=2, n_iter=5, random_state=0).fit(
         X, sequence_ids=ids
     )
-    quiet = model.sample(10, random_state=0)
-    noisy = model.sample(10, hidden_noise=1.0, random_state=0)
+    # one mean-field step: the many of the default settle every chain of a
+    # 5-epoch model at the same point, noise or not
+    quiet = model.sample(10, n_mean_field=1, random_state=0)
+    noisy = model.sample(10, hidden_noise=1.0, n_mean_field=1, random_state=0)
     assert not np.allclose(quiet, noisy)
 
 

@@ -278,3 +278,21 @@ def test_gibbs_frames_keep_observed_values_and_draw_as_before():
     current += visible_bias
     current[mask] = visible[mask]
     assert_allclose(frames, current, rtol=1e-12, atol=1e-12)
+
+
+def test_gibbs_frames_end_with_n_mean_field_steps():
+    params = make_params()
+    visible, history = batch(params, n=8)
+    visible_bias, hidden_bias = params.dynamic_biases(history)
+    rbms = frames_of(params, hidden_bias, visible_bias)
+    frames = gibbs_frames(rbms, visible, 5, np.random.default_rng(0), n_mean_field=4)
+
+    # the same chain written plainly: sampled hidden states, then mean field
+    rng = np.random.default_rng(0)
+    current = visible.copy()
+    for _ in range(5):
+        hidden = rng.random(hidden_bias.shape) < rbms.hidden_probabilities(current)
+        current = hidden @ params.weights + visible_bias
+    for _ in range(4):
+        current = rbms.hidden_probabilities(current) @ params.weights + visible_bias
+    assert_allclose(frames, current, rtol=1e-12, atol=1e-12)

@@ -42,7 +42,8 @@ X_MISSING[25:28] = np.nan  # wholly missing frames
 # history_noise is spelled out: its default changed (issue 15) after the
 # fingerprints were computed with clean histories; so is
 # history_noise_fraction where there is noise (its default changed later),
-# and average_fraction (added later with a default that averages).
+# and average_fraction (added later with a default that averages); so is
+# sample's n_mean_field (its default became 10 mean-field steps later).
 MODELS = {
     "order2": dict(n_components=8, order=2, history_noise=0.0),
     "order3_hidden1": dict(n_components=6, order=3, hidden_order=1, history_noise=0.0),
@@ -89,7 +90,7 @@ def _crbm_results():
             model.partial_fit(X[IDS < 2].astype(dtype), sequence_ids=IDS[IDS < 2])
             out.update(_fitted(f"partial_fit.{name}.{dtype}", model))
             out[f"sample.{name}.{dtype}"] = model.sample(
-                12, n_sequences=3, n_gibbs=5, random_state=1
+                12, n_sequences=3, n_gibbs=5, n_mean_field=1, random_state=1
             )
         model = _crbm("order2", dtype)
         key = f"order2.{dtype}"
@@ -98,7 +99,12 @@ def _crbm_results():
         out[f"predict_next.{key}"] = model.predict_next(X, sequence_ids=IDS)
         out[f"score.{key}"] = np.array(model.score(X, sequence_ids=IDS))
         out[f"sample_noise.{key}"] = model.sample(
-            3, n_sequences=260, n_gibbs=4, hidden_noise=0.3, random_state=2
+            3,
+            n_sequences=260,
+            n_gibbs=4,
+            hidden_noise=0.3,
+            n_mean_field=1,
+            random_state=2,
         )
         out[f"sample_visibles.{key}"] = model.sample(
             10, history=X[:5], n_sequences=2, sample_visibles=True, random_state=3
@@ -114,7 +120,9 @@ def _crbm_results():
     )
     binary.fit((X > 0).astype(float), sequence_ids=IDS)
     out.update(_fitted("fit.binary.float64", binary))
-    out["sample.binary.float64"] = binary.sample(8, n_sequences=2, random_state=0)
+    out["sample.binary.float64"] = binary.sample(
+        8, n_sequences=2, n_mean_field=1, random_state=0
+    )
     return out
 
 
@@ -167,7 +175,12 @@ def _stacked_results():
             for k, layer in enumerate(stack.layers_):
                 out.update(_fitted(f"stack.layer{k}.{key}", layer))
             out[f"stack.sample.{key}"] = stack.sample(
-                9, n_sequences=3, n_gibbs=5, hidden_noise=0.2, random_state=1
+                9,
+                n_sequences=3,
+                n_gibbs=5,
+                hidden_noise=0.2,
+                n_mean_field=1,
+                random_state=1,
             )
             out[f"stack.transform.{key}"] = stack.transform(X, sequence_ids=IDS)
             out[f"stack.predict_next.{key}"] = stack.predict_next(X, sequence_ids=IDS)

@@ -190,6 +190,8 @@ def _model_outputs(model, X, ids, styles=None, context=None):
     if context is not None:
         given = {"context": context}
         first, last = {"context": context[:1]}, {"context": context[-1:]}
+    # the stored outputs were drawn with one mean-field step, the default then
+    first, last = {**first, "n_mean_field": 1}, {**last, "n_mean_field": 1}
     outputs = [
         model.transform(X, sequence_ids=ids, **given),
         model.predict_next(X, sequence_ids=ids, **given),

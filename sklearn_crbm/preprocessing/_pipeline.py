@@ -200,7 +200,8 @@ class MotionPipeline(Pipeline):
         **params : dict
             Passed on to the model's ``sample``: ``context`` (every new
             frame's context, for a model fitted with one), ``style``,
-            ``n_gibbs``, ``hidden_noise``, ``sample_visibles``, ``n_jobs``.
+            ``n_gibbs``, ``hidden_noise``, ``sample_visibles``,
+            ``n_mean_field``, ``n_jobs``.
 
         Returns
         -------

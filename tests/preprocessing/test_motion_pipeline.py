@@ -48,8 +48,10 @@ def test_sample_is_the_models_sample_in_raw_channels(fitted, walker):
     # the same random_state gives the same motion; keyword arguments reach
     # the model's sample
     assert_array_equal(raw, fitted.sample(20, n_sequences=3, random_state=1, n_gibbs=5))
-    noisy = fitted.sample(20, n_sequences=3, random_state=1, n_gibbs=5, hidden_noise=2)
-    assert not np.allclose(raw, noisy)
+    one_step = fitted.sample(
+        20, n_sequences=3, random_state=1, n_gibbs=5, n_mean_field=1
+    )
+    assert not np.allclose(raw, one_step)
     with pytest.raises(TypeError, match="no_such_parameter"):
         fitted.sample(5, no_such_parameter=1)
 
