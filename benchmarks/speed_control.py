@@ -7,10 +7,8 @@ Protocol, per training seed (``--seeds``, 0-4):
   ``make_motion_pipeline``) and ``ConditionalRBM(random_state=seed)`` (the
   defaults, changed by ``--model``), trained with every frame's forward speed
   as its ``context``: ``MotionContext(skeleton, signals=["forward_speed"])``,
-  smoothed over 1 s, in ASF length units per second;
-- ``--context-scaling standard`` z-scores that speed over the training frames
-  (and every requested speed the same way) before the model sees it;
-  ``none`` (the default) gives the model the speed as it is;
+  smoothed over 1 s, in ASF length units per second, as it is (the model
+  standardises its context);
 - requests, each generated from ``--n-sequences`` real seed windows
   (``MotionPipeline.style_windows``, drawn with the training seed): a constant
   speed at the mean of the real walks' frames, at the mean of the jogs'
@@ -36,7 +34,6 @@ Run from the repository root (5 fits of about a minute the first time;
 fitted models are cached)::
 
     python benchmarks/speed_control.py
-    python benchmarks/speed_control.py --context-scaling standard
 """
 
 import json
@@ -53,7 +50,6 @@ from _common import (
     print_table,
     write_json,
 )
-from sklearn.preprocessing import StandardScaler
 
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm.exceptions import GenerationWarning
@@ -70,7 +66,7 @@ BEYOND = 1.1  # times the fastest jog trial's mean speed
 class SpeedTask:
     """CMU 35 with every frame's forward speed, and the requests to generate."""
 
-    def __init__(self, data_home, scaling):
+    def __init__(self, data_home):
         self.corpus = corpus = MotionCorpus(data_home, "cmu")
         data = corpus.data
         self.speed = MotionContext(
@@ -79,7 +75,6 @@ class SpeedTask:
         with sklearn.config_context(enable_metadata_routing=True):
             speeds = self.speed.fit_transform(data.data, sequence_ids=corpus.ids)
         self.speeds = speeds
-        self.scaler = StandardScaler().fit(speeds) if scaling == "standard" else None
         frame_styles = corpus.styles[corpus.ids]
         walk, jog = (float(speeds[frame_styles == s].mean()) for s in ("walk", "jog"))
         trial_speed = np.array(
@@ -101,7 +96,7 @@ class SpeedTask:
     def context(self, speed):
         """What the model is given for speeds ``(n_frames, 1)``."""
         speed = np.asarray(speed, dtype=float).reshape(-1, 1)
-        return speed if self.scaler is None else self.scaler.transform(speed)
+        return speed
 
     def fit(self, seed, model_params):
         """``(model, fit seconds)``: the model trained with every frame's speed."""
@@ -230,11 +225,10 @@ COLUMNS = [
 def main(argv=None):
     p = parser(__doc__)
     p.add_argument("--model", default="{}", help="ConditionalRBM parameters, JSON")
-    p.add_argument("--context-scaling", default="none", choices=("none", "standard"))
     p.add_argument("--n-sequences", type=int, default=6, help="per request")
     args = p.parse_args(argv)
     announce()
-    task = SpeedTask(args.data_home, args.context_scaling)
+    task = SpeedTask(args.data_home)
     print(
         f"real forward speed (units/s): walks {task.walk:.1f}, jogs {task.jog:.1f}",
         flush=True,
@@ -251,7 +245,7 @@ def main(argv=None):
     table = print_table(
         rows,
         COLUMNS,
-        title=f"\nSpeed control, context scaling {args.context_scaling!r}, seeds "
+        title=f"\nSpeed control, seeds "
         f"{args.seeds}, {args.n_sequences} sequences per request and seed",
     )
     payload = dict(

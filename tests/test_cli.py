@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import sklearn
-from numpy.testing import assert_array_equal
+from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
 from sklearn_crbm.cli import _main as _cli
@@ -596,14 +596,14 @@ def speed_model(tmp_path_factory):
     return model, output.getvalue(), folder
 
 
-def test_fit_speed_context_saves_the_speed_measure_and_scaler(speed_model):
+def test_fit_speed_context_saves_the_speed_measure(speed_model):
     model, report, folder = speed_model
     saved = _cli._load_model(model)
     assert saved.pipeline[-1].n_context_ == 1
     assert list(saved.speed.get_feature_names_out()) == ["forward_speed"]
     data = _cli._read_motion_folder(folder)
     speeds = saved.speed.transform(data.data, sequence_ids=data.sequence_ids)
-    assert_array_equal(saved.speed_scaler.mean_, speeds.mean(axis=0))
+    assert_allclose(saved.pipeline[-1].context_mean_, speeds.mean(axis=0))
     low, high = speeds.min(), speeds.max()
     assert f"forward speed as context: {low:.1f} to {high:.1f} length units" in report
 
@@ -613,7 +613,7 @@ def test_sample_speed_is_every_frames_context(speed_model):
     saved = _cli._load_model(model)
     args = argparse.Namespace(model=model, speed=(15.0, 21.0), n_frames=7)
     context = _cli._speed_request(saved, args)["context"]
-    expected = saved.speed_scaler.transform(np.linspace(15.0, 21.0, 7)[:, None])
+    expected = np.linspace(15.0, 21.0, 7)[:, None]
     assert_array_equal(context, expected)
     parsed = _cli._parser().parse_args(["sample", "m", "--speed", "40"]).speed
     assert parsed == (40.0, 40.0)

@@ -15,7 +15,6 @@ from pathlib import Path
 import joblib
 import numpy as np
 import sklearn
-from sklearn.preprocessing import StandardScaler
 from sklearn.utils import Bunch
 
 from .._base import generated_liveliness
@@ -155,9 +154,7 @@ def run_fit(args):
     _check_order(args.order, data)
     pipeline = make_motion_pipeline(data.skeleton, _model_from_args(args))
     speed = _speed_context(data, styles) if args.speed_context else {}
-    context = {}
-    if speed:
-        context["context"] = speed["speed_scaler"].transform(speed.pop("speeds"))
+    context = {"context": speed.pop("speeds")} if speed else {}
     pipeline.fit(data.data, sequence_ids=data.sequence_ids, **context)
     windows = {}
     if styles is not None:
@@ -177,7 +174,7 @@ def run_fit(args):
 
 
 def _speed_context(data, styles):
-    """``fit --speed-context``: the fitted speed measure, its scaler, the speeds.
+    """``fit --speed-context``: the fitted speed measure and the speeds.
 
     Prints the range of the training speeds (and each style's mean), the
     speeds ``sample --speed`` can ask for with confidence.
@@ -197,7 +194,7 @@ def _speed_context(data, styles):
         f"forward speed as context: {speeds.min():.1f} to {speeds.max():.1f} "
         f"length units per second{means}"
     )
-    return dict(speed=speed, speed_scaler=StandardScaler().fit(speeds), speeds=speeds)
+    return dict(speed=speed, speeds=speeds)
 
 
 def _training_data(args):
@@ -348,8 +345,7 @@ def run_sample(args):
 
 def _speed_request(saved, args):
     """``sample``'s context for ``--speed``: ``{}`` for a model without one."""
-    scaler = saved.get("speed_scaler")
-    if scaler is None:
+    if "speed" not in saved:
         if args.speed is not None:
             raise ValueError(
                 f"{args.model} was fitted without speed as context: fit it with "
@@ -359,11 +355,12 @@ def _speed_request(saved, args):
     if args.speed is None:
         raise ValueError(
             f"{args.model} was fitted with speed as context: give --speed (its "
-            f"training frames move at {scaler.mean_[0]:.1f} length units per "
+            "training frames move at "
+            f"{saved.pipeline[-1].context_mean_[0]:.1f} length units per "
             "second on average)."
         )
     requested = np.linspace(*args.speed, args.n_frames)[:, None]
-    return {"context": scaler.transform(requested)}
+    return {"context": requested}
 
 
 def _speed_text(saved, sequence):

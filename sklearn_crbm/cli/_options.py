@@ -252,8 +252,7 @@ COMMANDS = {
         "'seed_windows' (real frames of each style: CMU 35's walk and jog, "
         "or the labels of --labels), "
         "'frame_rate' and, with --speed-context, 'speed' (the fitted "
-        "MotionContext) and 'speed_scaler' (the StandardScaler of its "
-        "output that gives the model its context).",
+        "MotionContext whose output is the model's context).",
         [
             _option(
                 "folder",
