@@ -50,10 +50,12 @@ Measurements (the issue's "Done when"), each of ``--parts``:
   the paper's fill-in error to the best of ``KNNImputer(5)``,
   ``KNNImputer(10)`` and ``AutoregressiveImputer()``, averaged over styles,
   parts and seeds, with a 95% bootstrap interval.
-- ``one-take``: the one-take split: for every style, the share of windows
-  kept and alive (the unlabelled model seeded with frames of its take 001,
-  the others with a normal walk's), and the held-out log-likelihood of its
-  takes 002-006 (for ``separate``: of the CRBM trained on that one take).
+- ``one-take``: the one-take split: for every style (or those of
+  ``--one-take-styles``; runs of different styles merge in ``--tabulate``),
+  the share of windows kept and alive (the unlabelled model seeded with
+  frames of its take 001, the others with a normal walk's), and the
+  held-out log-likelihood of its takes 002-006 (for ``separate``: of the
+  CRBM trained on that one take).
 - ``speed``: training seconds per epoch (``separate``: its seven models
   together); generation frames per second for one sequence and per sequence
   of 100 generated together (the default Gibbs steps); for the labelled
@@ -622,7 +624,7 @@ def one_take(name, walks, args, seed, rng):
     cells = {}
     labels = walks.target_names[walks.target]
     takes = walks.takes[walks.sequence_ids]
-    for style in walks.target_names:
+    for style in args.one_take_styles or walks.target_names:
         train = (labels != style) | (takes == 1)
         split = Split(walks, train)
         Z, styles, ids = split.frames(train)
@@ -888,7 +890,7 @@ def table(results, seed=0):
             row = {
                 "candidate": f"{name} ({seeding})" if seeding else name,
                 "seeds": ",".join(str(seed) for seed in per_seed),
-                "params": str(next(iter(per_seed.values()))["n_parameters"]),
+                "params": str(next(iter(per_seed.values())).get("n_parameters", "-")),
             }
             if k == 0 and seeding is not None:
                 row["lowest style"] = _lowest_style(per_seed, seeding)
@@ -907,6 +909,37 @@ def table(results, seed=0):
         [(h, h, "s") for h in headers],
     )
     per_style_table(results)
+    one_take_table(results)
+
+
+def one_take_table(results):
+    """The one-take split per style: windows kept and alive, and the held-out
+    log-likelihood of the style's other takes, means over the seeds."""
+    rows = []
+    for name, per_seed in results.items():
+        cells = {}
+        for result in per_seed.values():
+            for style, cell in (result.get("one-take") or {}).items():
+                cells.setdefault(style, []).append(cell)
+        if not cells:
+            continue
+        row = {"candidate": name}
+        for style, found in sorted(cells.items()):
+            alive = np.mean([c["kept_alive"] for c in found])
+            mean = np.mean([c["log_likelihood"]["mean"] for c in found])
+            row[style] = f"{100 * alive:.0f}%; {mean:.2f}"
+        rows.append(row)
+    if rows:
+        styles = sorted({key for row in rows for key in row} - {"candidate"})
+        print()
+        print_table(
+            [
+                {key: row.get(key, "-") for key in ["candidate", *styles]}
+                for row in rows
+            ],
+            [("candidate", "candidate", "s")] + [(s, s, "s") for s in styles],
+            title="one take: kept & alive; held-out LL/frame of its other takes",
+        )
 
 
 def per_style_table(results):
@@ -935,6 +968,8 @@ def per_style_table(results):
 def run_candidate(name, walks, split, args, seed):
     Z, styles, ids = split.frames(split.train)
     rng = np.random.default_rng(seed)
+    if set(args.parts) == {"one-take"}:  # its splits train their own models
+        return {"one-take": one_take(name, walks, args, seed, rng)}
     candidate = CANDIDATES[name]()
     saved = Path(args.models or "") / f"{name}_seed{seed}.joblib"
     if args.models and saved.exists():  # fitted by an earlier run
@@ -977,6 +1012,8 @@ def cached_cell(name, seed, args, walks, split):
     for path in sorted([*PACKAGE.rglob("*.py"), Path(__file__)]):
         key.update(path.read_bytes())
     options = (name, seed, args.n_iter, args.parts, args.n_frames, args.n_sequences)
+    if args.one_take_styles:
+        options += tuple(args.one_take_styles)
     key.update(repr(options).encode())
     path = CACHE / "styles" / f"{name}_seed{seed}_{key.hexdigest()[:16]}.json"
     if path.exists():
@@ -987,6 +1024,16 @@ def cached_cell(name, seed, args, walks, split):
     return result
 
 
+def _merge(merged, parts):
+    """Add one run's parts of a seed to ``merged``; the one-take split's styles
+    run apart (``--one-take-styles``) merge too."""
+    for part, cells in parts.items():
+        if part == "one-take" and merged.get(part) and cells:
+            merged[part].update(cells)
+        else:
+            merged[part] = cells
+
+
 def tabulate(paths):
     """Print the tables of the results in earlier runs' JSON files, merged
     (seeds, and the parts of a seed)."""
@@ -994,7 +1041,7 @@ def tabulate(paths):
     for path in paths:
         for name, per_seed in json.loads(Path(path).read_text())["results"].items():
             for seed, parts in per_seed.items():  # parts of one seed run apart merge
-                results.setdefault(name, {}).setdefault(seed, {}).update(parts)
+                _merge(results.setdefault(name, {}).setdefault(seed, {}), parts)
     print(f"\nBandai walks, 7 styles; from {', '.join(paths)}\n")
     table(results)
     return results
@@ -1009,6 +1056,12 @@ def main(argv=None):
     p.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
     p.add_argument("--n-frames", type=int, default=1000)
     p.add_argument("--n-sequences", type=int, default=6)
+    p.add_argument(
+        "--one-take-styles",
+        nargs="+",
+        metavar="STYLE",
+        help="the styles of the one-take split (default: all seven)",
+    )
     p.add_argument(
         "--models", help="folder to save fitted candidates in (and reuse them from)"
     )

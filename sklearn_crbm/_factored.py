@@ -2,13 +2,31 @@
 
 from numbers import Integral, Real
 
+import numpy as np
 from sklearn.utils._param_validation import Interval
 
 from ._base import FittedParameter
 from ._style_model import BaseStyleModel
 from .layers._factored import FactoredLayer
+from .utils._array_api import to_numpy
 
 __all__ = ["FactoredCRBM"]
+
+
+def balanced_frames(frames, label_weights):
+    """``frames`` with each style's frames repeated to about the most frequent's count.
+
+    A frame's style is its largest label weight; a style with ``n`` frames is
+    repeated ``round(n_max / n)`` times (at least once), as the released code
+    copies the takes of the less frequent styles.  Copies stay next to their
+    frame, so the frames remain in time order.
+    """
+    styles = np.argmax(to_numpy(label_weights)[frames], axis=1)
+    counts = np.bincount(styles)
+    copies = np.zeros(len(counts), dtype=np.intp)
+    present = counts > 0
+    copies[present] = np.maximum(np.rint(counts.max() / counts[present]), 1)
+    return np.repeat(frames, copies[styles])
 
 
 class FactoredCRBM(BaseStyleModel):
@@ -56,6 +74,11 @@ class FactoredCRBM(BaseStyleModel):
     momentum_ramp : int, default=0
         Number of epochs after ``momentum_delay`` over which the momentum
         rises linearly to ``momentum`` (0: at once, as the released code).
+    balance_styles : bool, default=True
+        Train on every style about equally often: the frames of each style
+        are repeated (each frame's style is its largest label weight) until
+        it has about as many as the most frequent style, as the released
+        code copies takes.  False: every frame once.
     max_step : float or None, default=0.25
         Largest norm of one minibatch's step of each weight matrix, as a
         fraction of the matrix's norm before the step (the velocity is
@@ -193,6 +216,7 @@ class FactoredCRBM(BaseStyleModel):
         "n_style_features": [Interval(Integral, 1, None, closed="left")],
         "shared_style_weights": ["boolean"],
         "momentum_ramp": [Interval(Integral, 0, None, closed="left")],
+        "balance_styles": ["boolean"],
         "max_step": [Interval(Real, 0, None, closed="neither"), None],
         "n_gibbs": [Interval(Integral, 0, None, closed="left")],
         "learning_rate": [Interval(Real, 0, None, closed="neither")],
@@ -228,6 +252,7 @@ class FactoredCRBM(BaseStyleModel):
         momentum=0.9,
         momentum_delay=5,
         momentum_ramp=0,
+        balance_styles=True,
         max_step=0.25,
         weight_decay=2e-4,
         cd_steps=10,
@@ -258,6 +283,7 @@ class FactoredCRBM(BaseStyleModel):
         self.momentum = momentum
         self.momentum_delay = momentum_delay
         self.momentum_ramp = momentum_ramp
+        self.balance_styles = balance_styles
         self.max_step = max_step
         self.weight_decay = weight_decay
         self.cd_steps = cd_steps
@@ -278,6 +304,11 @@ class FactoredCRBM(BaseStyleModel):
         self.tol = tol
         self.random_state = random_state
         self.verbose = verbose
+
+    def _train(self, X, frames, n_epochs, n_averaged=0, context=None):
+        if self.balance_styles and self._labelled:
+            frames = balanced_frames(frames, context)
+        super()._train(X, frames, n_epochs, n_averaged, context)
 
     def _new_layer(self, n_features, n_context, dtype):
         return FactoredLayer(

@@ -259,6 +259,42 @@ def test_learning_rates_per_group_and_momentum_are_the_released_codes():
     assert [schedule.momentum_at(done) for done in (0, 4, 5, 199)] == [0, 0, 0.9, 0.9]
 
 
+def test_balanced_frames_repeat_each_style_to_the_most_frequents_count():
+    """Each style repeated round(n_max / n) times, next to its frames; a frame's
+    style is its largest label weight."""
+    from sklearn_crbm._factored import balanced_frames
+
+    frames = np.array([2, 3, 4, 5, 7, 8, 9])
+    weights = np.zeros((10, 3))
+    weights[:, 0] = 1.0  # frames 2-5 and 7: style 0 (five frames)
+    weights[[8, 9], :] = [[0.2, 0.8, 0.0], [0.0, 0.6, 0.4]]  # style 1 (two)
+    assert_array_equal(
+        balanced_frames(frames, weights), [2, 3, 4, 5, 7, 8, 8, 9, 9]
+    )  # 5 / 2 rounds to 2 copies; the empty style 2 takes none
+    weights[[8, 9], :] = [0.0, 0.0, 1.0]
+    weights[[2, 3], :] = [0.0, 1.0, 0.0]
+    # styles of 3, 2 and 2 frames: 3/2 rounds to 2
+    assert_array_equal(
+        balanced_frames(frames, weights), [2, 2, 3, 3, 4, 5, 7, 8, 8, 9, 9]
+    )
+
+
+def test_styles_are_balanced_by_default():
+    """The default trains on style-balanced frames (the released code's copies)."""
+    X, ids, styles = styled_data(switching=False)
+    keep = (styles == "high") | (ids < 2)  # four sequences high, one low
+    X, ids, styles = X[keep], ids[keep], styles[keep]
+    fits = {
+        balance: small_model(n_iter=3, balance_styles=balance).fit(
+            X, styles, sequence_ids=ids
+        )
+        for balance in (True, False)
+    }
+    default = small_model(n_iter=3).fit(X, styles, sequence_ids=ids)
+    assert_array_equal(default.style_factors_, fits[True].style_factors_)
+    assert not np.allclose(fits[True].style_factors_, fits[False].style_factors_)
+
+
 def _bounded_update(max_step, statistics):
     """One momentum step of a small layer, bounded; ``(before, after, update)``."""
     from sklearn_crbm._training import StepBound
