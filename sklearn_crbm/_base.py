@@ -123,6 +123,9 @@ class BaseCRBM(
     # Noise on the previous frame where a new frame's Gibbs chain starts.
     _start_jitter = START_JITTER
 
+    # Mean-field steps that end a generated frame unless sample is told.
+    _n_mean_field = 10
+
     # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
     # search passes ``sequence_ids`` and ``context`` to these methods without
     # being asked.
@@ -740,7 +743,7 @@ n_classes), default=None
         n_gibbs=None,
         hidden_noise=0.0,
         sample_visibles=False,
-        n_mean_field=10,
+        n_mean_field=None,
         random_state=None,
         n_jobs=None,
     ):
@@ -794,12 +797,14 @@ default=None
             ``n_gibbs`` is large.  The default keeps the original code's
             scheme (visible means, then mean field), which gives smoother
             motion.
-        n_mean_field : int, default=10
+        n_mean_field : int, default=None
             Mean-field steps that end each frame (ignored with
             ``sample_visibles``).  The original code takes one, which leaves
             the frame where the last sampled hidden states put it, and the
             frames shake; further steps settle it at the mean-field fixed
-            point of the mode the chain ended in.
+            point of the mode the chain ended in.  None: 10, or 1 for the
+            style models, where ten settle a blend of two styles into one
+            gait.
         random_state : int, RandomState instance or None, default=None
             Seeds the generation; ``None`` uses the estimator's
             ``random_state``, so repeated calls give the same frames when
@@ -825,6 +830,8 @@ default=None
             n_gibbs = self.get_params().get("n_gibbs", DEFAULT_N_GIBBS)
         n_gibbs = check_count(n_gibbs, "n_gibbs", minimum=0)
         n_sequences = check_count(n_sequences, "n_sequences", minimum=1)
+        if n_mean_field is None:
+            n_mean_field = self._n_mean_field
         n_mean_field = check_count(n_mean_field, "n_mean_field", minimum=1)
         if not isinstance(hidden_noise, Real) or not hidden_noise >= 0:
             raise ValueError(
