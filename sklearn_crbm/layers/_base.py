@@ -84,6 +84,7 @@ N(c_hat + s (W_t^T h), diag(s^2))`` (binary: ``sigmoid`` of it).
 
 import functools
 import math
+from abc import ABCMeta, abstractmethod
 
 import numpy as np
 
@@ -308,7 +309,7 @@ class BinaryUnits(GaussianUnits):
 VISIBLE_UNITS = {GAUSSIAN: GaussianUnits(), BINARY: BinaryUnits()}
 
 
-class FrameRBMs:
+class FrameRBMs(metaclass=ABCMeta):
     """The RBMs of a set of frames: one layer given each frame's past and context.
 
     Subclasses (one per kind of layer) compute the interaction of each
@@ -352,13 +353,13 @@ class FrameRBMs:
         """``W`` (n_components, n_features) when it is every frame's, else None."""
         return None
 
+    @abstractmethod
     def interaction_input(self, visible, out=None):
         """``W_t (v / s)`` of every frame's row of ``visible``."""
-        raise NotImplementedError
 
+    @abstractmethod
     def interaction_field(self, hidden, out=None):
         """``s * (W_t^T h)`` of every frame's row of ``hidden``."""
-        raise NotImplementedError
 
     # -------------------------------------------------------------- generic
 
@@ -472,7 +473,7 @@ class TrainingWorkspace:
         return self._visible[:n, ...]
 
 
-class ConditionalLayer(PackedParameters):
+class ConditionalLayer(PackedParameters, metaclass=ABCMeta):
     """Base class of the kinds of conditional layer (see the module docstring).
 
     Attributes
@@ -521,9 +522,9 @@ class ConditionalLayer(PackedParameters):
         """What every frame's RBM shares (a dict), for :meth:`build_frame_rbms`."""
         return {}
 
+    @abstractmethod
     def build_frame_rbms(self, invariants, history, context=None, *, out=None):
         """The frame RBMs of ``n`` frames, given :meth:`frame_invariants`."""
-        raise NotImplementedError
 
     def product_size(self):
         """Multiply-adds per frame of the layer's largest matrix product.
@@ -544,6 +545,7 @@ class ConditionalLayer(PackedParameters):
             state["n_context"] = state.pop("n_classes")
         super().__setstate__(state)
 
+    @abstractmethod
     def cd_statistics(
         self, visible, history, context, cd_steps, rng, *, out, scale, workspace
     ):
@@ -552,7 +554,6 @@ class ConditionalLayer(PackedParameters):
         Returns ``out`` and the summed squared reconstruction error (a float
         on numpy, a 0-d array of the namespace otherwise).
         """
-        raise NotImplementedError
 
     def training_copy(self):
         """The parameters training updates: a copy in the layout BLAS runs fastest."""
