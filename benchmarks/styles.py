@@ -206,9 +206,10 @@ CRBM_PARAMETERS = (
 ).split()
 
 
-def _new(estimator, seed, n_iter):
-    """``estimator`` with the package's defaults (but ``n_iter`` if given)."""
-    model = estimator(random_state=seed)
+def _new(estimator, seed, n_iter, params=None):
+    """``estimator`` with the package's defaults but ``params`` (and ``n_iter``
+    if given)."""
+    model = estimator(random_state=seed).set_params(**(params or {}))
     return model if n_iter is None else model.set_params(n_iter=n_iter)
 
 
@@ -241,6 +242,9 @@ class Candidate(ABC):
 
     name = ""
     controls_style = True  # False: its style is that of the frames seeding it
+
+    def __init__(self, params=None):
+        self.params = params  # estimator parameters other than the defaults
 
     @abstractmethod
     def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
@@ -286,7 +290,7 @@ class Unlabelled(Candidate):
     controls_style = False
 
     def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
-        self.model = _new(ConditionalRBM, seed, n_iter)
+        self.model = _new(ConditionalRBM, seed, n_iter, self.params)
         self.model.fit(Z, sequence_ids=sequence_ids)
         return self
 
@@ -311,7 +315,7 @@ class Separate(Candidate):
     def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
         self.classes_ = np.unique(styles)
         self.models = {
-            style: _new(ConditionalRBM, seed, n_iter).fit(
+            style: _new(ConditionalRBM, seed, n_iter, self.params).fit(
                 Z[styles == style], sequence_ids=sequence_ids[styles == style]
             )
             for style in (self.classes_ if only is None else only)
@@ -373,7 +377,7 @@ class StyleModel(Candidate):
     parameters = ()  # its fitted arrays, for the count of parameters
 
     def fit(self, Z, styles, sequence_ids, *, seed, n_iter, only=None):
-        self.model = _new(self.estimator, seed, n_iter)
+        self.model = _new(self.estimator, seed, n_iter, self.params)
         self.model.fit(Z, styles, sequence_ids=sequence_ids)
         self.styles = styles
         return self
@@ -628,7 +632,7 @@ def one_take(name, walks, args, seed, rng):
         train = (labels != style) | (takes == 1)
         split = Split(walks, train)
         Z, styles, ids = split.frames(train)
-        candidate = CANDIDATES[name]().fit(
+        candidate = CANDIDATES[name](args.params).fit(
             Z, styles, ids, seed=seed, n_iter=args.n_iter, only=[style]
         )
         weights = label_weights(split.styles, args.n_frames, style)
@@ -640,7 +644,11 @@ def one_take(name, walks, args, seed, rng):
         cells[style] = dict(
             kept_cell(verdict, pace, blown), log_likelihood=log_likelihood
         )
-        print(f"    one take, {style}: {cells[style]['kept']:.0%} kept", flush=True)
+        print(
+            f"    one take, {style}: {cells[style]['kept_alive']:.0%} kept and "
+            f"alive, held-out LL {log_likelihood['mean']:.2f}",
+            flush=True,
+        )
     return cells
 
 
@@ -798,19 +806,19 @@ def _blown_up_total(rows):
     return str(sum(cell["blown_up"] for row in rows for cell in row))
 
 
-def _blends(rows):
+def _blends(rows, rng):
     """Pairs (mean over seeds) with the speed between the two styles', pairs
-    with at least 80% of windows judged one of the two (and the mean share),
-    pairs with the step frequency between."""
+    with at least 80% of windows judged one of the two (and the mean share of
+    windows with its interval), pairs with the step frequency between."""
     n = len(rows[0])
 
     def pairs(passes):
         return f"{np.mean([sum(passes(c) for c in row) for row in rows]):.1f}/{n}"
 
-    one_of_two = np.mean([c["one_of_two"] for row in rows for c in row])
+    one_of_two = _interval(rows, "one_of_two", rng)
     return (
         f"{pairs(lambda c: c['speed_between'])}; "
-        f"{pairs(lambda c: c['one_of_two'] >= 0.8)} ({100 * one_of_two:.0f}%); "
+        f"{pairs(lambda c: c['one_of_two'] >= 0.8)} ({one_of_two}); "
         f"freq {pairs(lambda c: c['frequency_between'])}"
     )
 
@@ -843,7 +851,11 @@ def _one_take(rows):
 
 
 def _epoch(rows):
-    return f"{np.mean([row[0]['seconds_per_epoch'] for row in rows]):.2f}"
+    """Seconds per epoch, mean over the seeds that were trained in their run
+    (a model loaded with ``--models`` has no training time)."""
+    timed = [row[0]["seconds_per_epoch"] for row in rows]
+    timed = [t for t in timed if np.isfinite(t)]
+    return f"{np.mean(timed):.2f}" if timed else "-"
 
 
 # (column, part, formatter of the per-seed rows of cells; ``rng`` for the
@@ -863,9 +875,9 @@ COLUMNS = [
         lambda r, g: _interval(r, "new_alive", g),
     ),
     (
-        "blends: speed between; 1 of 2 >= 80% (mean); freq",
+        "blends: speed between; 1 of 2 >= 80% (windows [95%]); freq",
         "blends",
-        lambda r, g: _blends(r),
+        _blends,
     ),
     ("held-out LL/frame", "likelihood", lambda r, g: _likelihood(r)),
     ("one take: kept & alive; LL", "one-take", lambda r, g: _one_take(r)),
@@ -951,7 +963,7 @@ def per_style_table(results):
                 continue
             means = {}
             for result in per_seed.values():
-                for style, cell in result["style"][seeding].items():
+                for style, cell in result.get("style", {}).get(seeding, {}).items():
                     means.setdefault(style, []).append(cell["kept_alive"])
             row = {"candidate": f"{name} ({seeding})"}
             row.update({s: f"{100 * np.mean(v):.0f}%" for s, v in means.items()})
@@ -965,13 +977,21 @@ def per_style_table(results):
 
 
 # ------------------------------------------------------------------- main
+def _params_tag(args):
+    """A file-name suffix that tells models of other ``--params`` apart."""
+    if not args.params:
+        return ""
+    text = json.dumps(args.params, sort_keys=True).encode()
+    return "_" + hashlib.sha1(text).hexdigest()[:8]
+
+
 def run_candidate(name, walks, split, args, seed):
     Z, styles, ids = split.frames(split.train)
     rng = np.random.default_rng(seed)
     if set(args.parts) == {"one-take"}:  # its splits train their own models
         return {"one-take": one_take(name, walks, args, seed, rng)}
-    candidate = CANDIDATES[name]()
-    saved = Path(args.models or "") / f"{name}_seed{seed}.joblib"
+    candidate = CANDIDATES[name](args.params)
+    saved = Path(args.models or "") / f"{name}_seed{seed}{_params_tag(args)}.joblib"
     if args.models and saved.exists():  # fitted by an earlier run
         vars(candidate).update(joblib.load(saved))
         fit_seconds = float("nan")
@@ -1012,6 +1032,8 @@ def cached_cell(name, seed, args, walks, split):
     for path in sorted([*PACKAGE.rglob("*.py"), Path(__file__)]):
         key.update(path.read_bytes())
     options = (name, seed, args.n_iter, args.parts, args.n_frames, args.n_sequences)
+    if args.params:
+        options += tuple(sorted(args.params.items()))
     if args.one_take_styles:
         options += tuple(args.one_take_styles)
     key.update(repr(options).encode())
@@ -1063,6 +1085,13 @@ def main(argv=None):
         help="the styles of the one-take split (default: all seven)",
     )
     p.add_argument(
+        "--params",
+        type=json.loads,
+        metavar="JSON",
+        help="estimator parameters other than the defaults, for every candidate's "
+        "models, e.g. '{\"history_noise_fraction\": 0.5}'",
+    )
+    p.add_argument(
         "--models", help="folder to save fitted candidates in (and reuse them from)"
     )
     p.add_argument(
@@ -1087,7 +1116,7 @@ def main(argv=None):
     print(
         f"\nBandai walks, 7 styles; trained on takes 001-005, judged over "
         f"{args.n_sequences} x {args.n_frames} frames per style; seeds {args.seeds}, "
-        f"n_iter {args.n_iter or 'default'}\n"
+        f"n_iter {args.n_iter or 'default'}, parameters {args.params or 'default'}\n"
     )
     table(results)
     output = Path(args.output)
