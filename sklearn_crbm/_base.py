@@ -70,10 +70,13 @@ START_JITTER = 0.01
 # cycle of walking or waving at 30 frames per second) against the same
 # number of last frames of every training sequence: moving less than
 # DEAD_FRACTION as much, it died out; beyond BLOWN_DEVIATIONS standard
-# deviations of the widest channel from the training mean, it blew up.
+# deviations of the widest channel from the training mean and BLOWN_REACH
+# times as far as the channel's training frames went, it blew up (the toes
+# of real walks reach 13.5 such deviations).
 LIVELINESS_FRAMES = 100
 DEAD_FRACTION = 0.5
 BLOWN_DEVIATIONS = 10.0
+BLOWN_REACH = 2.0
 
 
 class BaseCRBM(
@@ -330,14 +333,16 @@ class BaseCRBM(
         context = self._fit_context(X, y, context, reset=False)
         return self._representations(X, sequences, self._layers(), context)[-1]
 
-    def _keep_seeds(self, X, sequences, merge=False):
+    def _keep_seeds(self, X, sequences, merge=False, context=None):
         """Keep windows of ``X`` to seed :meth:`sample`, and what it judges by.
 
-        Sets ``seed_windows_`` and ``generation_statistics_``; with
+        Sets ``seed_windows_`` and ``generation_statistics_`` (per style too
+        for a model fitted on labels, whose ``context`` holds them); with
         ``merge`` (``partial_fit``), joined to those of the earlier calls.
         """
         windows = self._pick_seed_windows(X, sequences)
-        statistics = generation_statistics(X, sequences)
+        labels = self._liveliness_labels(context)
+        statistics = generation_statistics(X, sequences, labels)
         if merge and hasattr(self, "seed_windows_"):
             windows = self._merge_seed_windows(windows)
         if merge and hasattr(self, "generation_statistics_"):
@@ -841,6 +846,7 @@ default=None
         context = self._method_context(context, style, n_samples, like, one_row=True)
         if context is None and self.n_context_:
             raise self._missing_context_error()
+        labels = self._liveliness_labels(context)  # before it is broadcast
         rng = rng_from(self.random_state if random_state is None else random_state)
         seed = seed_frames(
             history,
@@ -866,10 +872,15 @@ default=None
             n_mean_field=n_mean_field,
             n_jobs=n_jobs,
         )
-        self._check_generated(frames, n_samples)
+        self._check_generated(frames, n_samples, labels)
         return frames
 
-    def _check_generated(self, frames, n_frames):
+    def _liveliness_labels(self, context):
+        """The label weights ``sample`` judges liveliness by (None: all
+        training sequences alike); models fitted on labels return them."""
+        return None
+
+    def _check_generated(self, frames, n_frames, labels=None):
         """Warn with a :class:`GenerationWarning` about sequences that died out
         or blew up (a model fitted before ``generation_statistics_`` existed
         is not judged)."""
@@ -878,7 +889,9 @@ default=None
             return
         # binary visibles stay within [0, 1]: only non-finite values blew up
         scale = np.inf if self._layers()[0].binary else statistics.scale
-        message = lifeless_message(to_numpy(frames), n_frames, statistics, scale)
+        message = lifeless_message(
+            to_numpy(frames), n_frames, statistics, scale, labels
+        )
         if message:
             warnings.warn(message, GenerationWarning, stacklevel=_caller_level())
 
@@ -1118,66 +1131,131 @@ def check_context(context, n_frames, n_context, like, *, one_row=False):
     return context
 
 
-def generation_statistics(X, sequences):
+def generation_statistics(X, sequences, labels=None):
     """What ``sample`` judges generated motion against, from the training data.
 
     A :class:`~sklearn.utils.Bunch`: ``mean`` (every channel's mean),
     ``scale`` (the largest channel standard deviation), ``amplitude`` (the
     :func:`~sklearn_crbm.metrics.motion_amplitude` of the last
     ``LIVELINESS_FRAMES`` frames of every sequence, their mean weighted by
-    those frames) and ``n_frames``.
+    those frames), ``reach`` (every channel's largest distance from its
+    mean) and ``n_frames``.  Given the frames' label weights
+    ``labels`` (shape ``(n_frames, n_classes)``), also ``label_amplitude``:
+    that mean for each style alone, each sequence weighted by its frames'
+    weight for the style, and ``label_weight``: those weights' sums.
     """
     X = to_numpy(X).astype(np.float64, copy=False)
     amplitudes = motion_amplitude(
         X, sequence_ids=sequences.per_frame_ids(), last_frames=LIVELINESS_FRAMES
     )
     weights = np.minimum(sequences.lengths, LIVELINESS_FRAMES)
-    return Bunch(
-        mean=X.mean(axis=0),
+    mean = X.mean(axis=0)
+    statistics = Bunch(
+        mean=mean,
         scale=float(X.std(axis=0).max()),
         amplitude=float(np.average(amplitudes, weights=weights)),
+        reach=np.abs(X - mean).max(axis=0),
         n_frames=X.shape[0],
     )
+    if labels is not None:
+        labels = to_numpy(labels).astype(np.float64, copy=False)
+        # each sequence's label weights summed over its last frames
+        sums = np.array(
+            [
+                labels[stop - n : stop].sum(axis=0)
+                for stop, n in zip(sequences.stops, weights, strict=True)
+            ]
+        )
+        label_weight = sums.sum(axis=0)
+        weighted = amplitudes @ sums
+        statistics.update(
+            label_amplitude=_ratio(weighted, label_weight), label_weight=label_weight
+        )
+    return statistics
+
+
+def _ratio(numerator, denominator):
+    """``numerator / denominator``, NaN where the denominator is 0."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(denominator > 0, numerator / denominator, np.nan)
 
 
 def merge_statistics(old, new):
     """The :func:`generation_statistics` of two calls of ``partial_fit``, joined."""
     total = old.n_frames + new.n_frames
     share = new.n_frames / total
-    return Bunch(
-        mean=old.mean + share * (new.mean - old.mean),
+    mean = old.mean + share * (new.mean - old.mean)
+    merged = Bunch(
+        mean=mean,
         scale=max(old.scale, new.scale),
         amplitude=old.amplitude + share * (new.amplitude - old.amplitude),
         n_frames=total,
     )
+    if "reach" in old and "reach" in new:  # at most this far from the new mean
+        merged.reach = np.maximum(
+            old.reach + np.abs(old.mean - mean), new.reach + np.abs(new.mean - mean)
+        )
+    if "label_amplitude" in old and "label_amplitude" in new:
+        weight = old.label_weight + new.label_weight
+        weighted = [
+            np.nan_to_num(part.label_amplitude) * part.label_weight
+            for part in (old, new)
+        ]
+        merged.update(
+            label_amplitude=_ratio(weighted[0] + weighted[1], weight),
+            label_weight=weight,
+        )
+    return merged
 
 
-def generated_liveliness(frames, n_frames, statistics):
+def reference_amplitude(statistics, labels=None):
+    """The training amplitude a generated sequence is compared with.
+
+    Given the label weights of its last frames (``labels``, shape
+    ``(n_frames, n_classes)``) and statistics of a model fitted on labels:
+    the styles' amplitudes (``label_amplitude``) weighted by the mean label
+    weights of the last ``LIVELINESS_FRAMES`` frames, so that a slow style is
+    judged against its own training takes; otherwise ``amplitude``.
+    """
+    if labels is None or "label_amplitude" not in statistics:
+        return statistics.amplitude
+    weights = to_numpy(labels)[-LIVELINESS_FRAMES:].mean(axis=0)
+    known = np.isfinite(statistics.label_amplitude)
+    if not np.any(weights[known] > 0):
+        return statistics.amplitude
+    return float(np.average(statistics.label_amplitude[known], weights=weights[known]))
+
+
+def generated_liveliness(frames, n_frames, statistics, labels=None):
     """How much every generated sequence moves at its end, against training.
 
     The amplitude (:func:`~sklearn_crbm.metrics.motion_amplitude`) of the
     last ``LIVELINESS_FRAMES`` frames of every sequence of ``frames`` (long
-    format, ``n_frames`` each) over ``statistics.amplitude``: 1 moves as much
-    as the training sequences; NaN where fewer frames were generated.
+    format, ``n_frames`` each) over :func:`reference_amplitude` (the
+    training sequences', or those of the styles ``labels`` ask for): 1 moves
+    as much as they do; NaN where fewer frames were generated.
     """
     n_sequences = len(frames) // n_frames
-    if n_frames < LIVELINESS_FRAMES or not statistics.amplitude > 0:
+    reference = reference_amplitude(statistics, labels)
+    if n_frames < LIVELINESS_FRAMES or not reference > 0:
         return np.full(n_sequences, np.nan)
     amplitude = motion_amplitude(
         np.nan_to_num(frames),  # what blew up is judged as blown, not here
         sequence_ids=np.repeat(np.arange(n_sequences), n_frames),
         last_frames=LIVELINESS_FRAMES,
     )
-    return amplitude / statistics.amplitude
+    return amplitude / reference
 
 
-def lifeless_message(frames, n_frames, statistics, scale=None):
+def lifeless_message(frames, n_frames, statistics, scale=None, labels=None):
     """What went wrong with generated ``frames`` (long format), or "" if nothing.
 
-    A sequence blew up when a value is non-finite or more than
+    A sequence blew up when a value is non-finite, or more than
     ``BLOWN_DEVIATIONS`` times ``scale`` (default ``statistics.scale``) from
-    the training mean;
-    it died out when its :func:`generated_liveliness` is below
+    the training mean and ``BLOWN_REACH`` times as far as its channel's
+    training values went (``statistics.reach``, where kept);
+    it died out when its :func:`generated_liveliness` (against the styles
+    the label weights ``labels`` ask for, if given) is below
     ``DEAD_FRACTION`` (judged only when ``LIVELINESS_FRAMES`` frames or more
     were generated).
     """
@@ -1185,24 +1263,33 @@ def lifeless_message(frames, n_frames, statistics, scale=None):
     with np.errstate(invalid="ignore", over="ignore"):
         scale = statistics.scale if scale is None else scale
         distance = np.abs(sequences - statistics.mean) / scale
-        reach = np.where(np.isfinite(distance), distance, np.inf).max(axis=(1, 2))
-    blown = np.flatnonzero(reach > BLOWN_DEVIATIONS)
-    liveliness = generated_liveliness(frames, n_frames, statistics)
+        distance = np.where(np.isfinite(distance), distance, np.inf)
+        limit = BLOWN_DEVIATIONS
+        if "reach" in statistics:
+            limit = np.maximum(limit, BLOWN_REACH * statistics.reach / scale)
+        over = (distance > limit).any(axis=(1, 2))
+    reach = distance.max(axis=(1, 2))
+    blown = np.flatnonzero(over)
+    liveliness = generated_liveliness(frames, n_frames, statistics, labels)
     dead = np.setdiff1d(np.flatnonzero(liveliness < DEAD_FRACTION), blown)
+    compared = "the training sequences"
+    if labels is not None and "label_amplitude" in statistics:
+        compared += " of the style asked for"
     parts = []
     if len(blown):
         parts.append(
             f"{_count(blown, len(sequences))} blew up (values up to "
             f"{reach[blown].max():.3g} training standard deviations from the "
-            "training mean, or non-finite). Train longer (n_iter), lower "
+            "training mean, beyond where the training frames went, or "
+            "non-finite). Train longer (n_iter), lower "
             "learning_rate, or seed with real frames (history=)."
         )
     if len(dead):
         parts.append(
             f"{_count(dead, len(sequences))} died out: over the last "
             f"{LIVELINESS_FRAMES} frames, moving at most "
-            f"{liveliness[dead].max():.2f} times as much as the training "
-            f"sequences (below {DEAD_FRACTION}: the motion came to rest). "
+            f"{liveliness[dead].max():.2f} times as much as {compared} "
+            f"(below {DEAD_FRACTION}: the motion came to rest). "
             "Train for more updates (raise n_iter) or on more frames, or seed "
             "with real frames of the motion wanted (history=); see the user "
             "guide's 'Training on your own corpus'."

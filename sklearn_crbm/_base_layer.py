@@ -130,7 +130,7 @@ class BaseLayerModel(BaseCRBM):
                 n_epochs = self._n_epochs(len(frames))
                 n_averaged = math.ceil(self.average_fraction * n_epochs)
                 self._train(X, frames, n_epochs, n_averaged, context)
-            self._keep_seeds(X, sequences)
+            self._keep_seeds(X, sequences, context=context)
         return self
 
     @limit_blas_threads(batch_rows)
@@ -178,7 +178,7 @@ class BaseLayerModel(BaseCRBM):
                 self._initialize(X, context)
                 self._start_parameters(X, frames, context)
             self._train(X, frames, 1, context=context)
-        self._keep_seeds(X, sequences, merge=True)
+        self._keep_seeds(X, sequences, merge=True, context=context)
         return self
 
     def _layers(self):

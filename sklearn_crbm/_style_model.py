@@ -257,6 +257,9 @@ class BaseStyleModel(BaseLayerModel):
             )
         return weights
 
+    def _liveliness_labels(self, context):
+        return to_numpy(context) if self._labelled and context is not None else None
+
     def _as_context(self, weights, like):
         ops = array_ops(like)
         return ops.asarray(weights, dtype=like.dtype)

@@ -9,13 +9,15 @@ import pytest
 import sklearn
 
 import sklearn_crbm
-from sklearn_crbm import ConditionalRBM, FactoredCRBM, StackedCRBM
+from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM, StackedCRBM
 from sklearn_crbm._base import (
     BLOWN_DEVIATIONS,
+    BLOWN_REACH,
     DEAD_FRACTION,
     LIVELINESS_FRAMES,
     generated_liveliness,
     lifeless_message,
+    reference_amplitude,
 )
 from sklearn_crbm.datasets import make_oscillations, make_walker
 from sklearn_crbm.exceptions import GenerationWarning, TrainingDivergedError
@@ -80,6 +82,37 @@ def test_lifeless_message_names_dead_and_blown_sequences():
     not_finite = lively.copy()
     not_finite[10, 0] = np.nan
     assert "blew up (values up to inf" in lifeless_message(not_finite, 200, stats)
+
+
+def test_a_channel_is_blown_only_beyond_where_its_training_values_went():
+    """A channel of small spread with rare far values (a toe) is judged
+    against how far its training values went, the others as before."""
+    rng = np.random.default_rng(0)
+    X = rng.normal(scale=[1.0, 0.3], size=(1000, 2))
+    X[100, 1] = 13.0  # one training value beyond BLOWN_DEVIATIONS widest spreads
+    model = ConditionalRBM(4, order=1, n_iter=1, random_state=0).fit(X)
+    stats = _statistics(model)
+    np.testing.assert_allclose(stats.reach, np.abs(X - X.mean(axis=0)).max(axis=0))
+    like_training = X[:200].copy()
+    assert np.abs(like_training - stats.mean).max() > BLOWN_DEVIATIONS * stats.scale
+    assert lifeless_message(like_training, 200, stats) == ""
+    beyond = like_training.copy()
+    beyond[100, 1] = stats.mean[1] + BLOWN_REACH * stats.reach[1] * 1.01
+    assert "Sequence 0 of 1 blew up" in lifeless_message(beyond, 200, stats)
+    ordinary = like_training.copy()  # the other channel's limit is unchanged
+    ordinary[100, 0] = stats.mean[0] + 1.01 * BLOWN_DEVIATIONS * stats.scale
+    assert "blew up" in lifeless_message(ordinary, 200, stats)
+
+
+def test_partial_fit_bounds_the_reach_of_its_calls(oscillations):
+    X, ids = oscillations
+    model = ConditionalRBM(8, random_state=0)
+    for part in (ids < 2, ids >= 2):
+        model.partial_fit(X[part], sequence_ids=ids[part])
+    exact = np.abs(X - X.mean(axis=0)).max(axis=0)
+    bound = _statistics(model).reach
+    assert np.all(bound >= exact - 1e-12)
+    assert np.all(bound <= exact + 2 * np.abs(X.mean(axis=0)).max() + 1)
 
 
 def test_short_sequences_are_judged_only_for_blowing_up():
@@ -155,6 +188,80 @@ def test_a_model_pickled_before_the_statistics_samples_without_judging(oscillati
     with warnings.catch_warnings():
         warnings.simplefilter("error", GenerationWarning)
         old.sample(LIVELINESS_FRAMES, random_state=0)
+
+
+def _slow_and_fast(oscillations, slow=0.3):
+    """Two styles of the oscillations: "fast" as they are, "slow" at ``slow``
+    times their amplitude (about the mean)."""
+    X, ids = oscillations
+    styles = np.where(ids < 2, "fast", "slow")
+    mean = X.mean(axis=0)
+    X = np.where(styles[:, None] == "slow", mean + slow * (X - mean), X)
+    return X, ids, styles
+
+
+def _last_amplitude(part):
+    return np.sqrt(part[-LIVELINESS_FRAMES:].var(axis=0).mean())
+
+
+@pytest.mark.parametrize("estimator", [FactoredCRBM, LabelledCRBM])
+def test_style_models_keep_each_styles_amplitude(oscillations, estimator):
+    X, ids, styles = _slow_and_fast(oscillations)
+    model = estimator(8, n_iter=2, random_state=0)
+    model.fit(X, styles, sequence_ids=ids)
+    stats = _statistics(model)
+    for k, style in enumerate(model.classes_):
+        own = [_last_amplitude(X[ids == i]) for i in np.unique(ids[styles == style])]
+        assert stats.label_amplitude[k] == pytest.approx(np.mean(own))
+    np.testing.assert_allclose(stats.label_weight, [2 * LIVELINESS_FRAMES] * 2)
+    assert stats.amplitude == pytest.approx(stats.label_amplitude.mean())
+
+
+def test_a_slow_style_is_judged_against_its_own_takes(oscillations):
+    X, ids, styles = _slow_and_fast(oscillations)
+    model = FactoredCRBM(8, n_factors=4, n_iter=2, random_state=0)
+    stats = _statistics(model.fit(X, styles, sequence_ids=ids))
+    slow_takes = X[styles == "slow"]  # real motion of the slow style
+    slow, fast = np.eye(2)[[1]], np.eye(2)[[0]]
+    pooled = generated_liveliness(slow_takes, 150, stats)
+    assert np.all(pooled < DEAD_FRACTION)  # the pooled reference calls it dead
+    own = generated_liveliness(slow_takes, 150, stats, slow)
+    assert own.mean() == pytest.approx(1)  # the sequences' mean is the reference
+    assert lifeless_message(slow_takes, 150, stats, labels=slow) == ""
+    # the fast style's motion at the slow style's amplitude has died out
+    message = lifeless_message(slow_takes, 150, stats, labels=fast)
+    assert "Sequences 0, 1 of 2 died out" in message
+    assert "as the training sequences of the style asked for" in message
+    # a blend is judged against the mean of its styles' amplitudes
+    half = reference_amplitude(stats, np.full((1, 2), 0.5))
+    assert half == pytest.approx(stats.label_amplitude.mean())
+
+
+def test_unlabelled_statistics_and_labels_give_the_pooled_reference(oscillations):
+    X, ids = oscillations
+    model = ConditionalRBM(8, n_iter=2, random_state=0).fit(X, sequence_ids=ids)
+    stats = _statistics(model)
+    assert "label_amplitude" not in stats
+    assert reference_amplitude(stats, np.eye(2)[[0]]) == stats.amplitude
+
+
+def test_partial_fit_joins_each_styles_amplitude(oscillations):
+    X, ids, styles = _slow_and_fast(oscillations)
+    model = FactoredCRBM(8, n_factors=4, random_state=0)
+    for part in (ids % 2 == 0, ids % 2 == 1):  # one take of each style per call
+        model.partial_fit(X[part], styles[part], sequence_ids=ids[part])
+    whole = FactoredCRBM(8, n_factors=4, n_iter=1, random_state=0)
+    whole.fit(X, styles, sequence_ids=ids)
+    joined, expected = _statistics(model), _statistics(whole)
+    np.testing.assert_allclose(joined.label_amplitude, expected.label_amplitude)
+    np.testing.assert_allclose(joined.label_weight, expected.label_weight)
+
+
+def test_sample_judges_a_style_model_by_the_style_asked_for(oscillations):
+    X, ids, styles = _slow_and_fast(oscillations)
+    model = FactoredCRBM(n_iter=5, random_state=0).fit(X, styles, sequence_ids=ids)
+    with pytest.warns(GenerationWarning, match="of the style asked for"):
+        model.sample(LIVELINESS_FRAMES, style="fast", n_sequences=2, random_state=0)
 
 
 def test_the_exceptions_module_is_public():
