@@ -106,6 +106,7 @@ from _common import (  # noqa: E402
     seconds,
 )
 from sklearn.impute import KNNImputer  # noqa: E402
+from sklearn.utils import Bunch  # noqa: E402
 
 from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM  # noqa: E402
 from sklearn_crbm.datasets import bone_columns, load_bandai_walks  # noqa: E402
@@ -517,19 +518,12 @@ def blends(candidate, split, args, rng):
         weights = label_weights(split.styles, args.n_frames, first, second, blend=0.5)
         if not candidate.can_generate(weights):
             return None
-        frames = generate(candidate, split, weights, NORMAL, args, rng)
-        blown = _blown_up(split, frames, args.n_sequences)
-        frames = np.where(np.isfinite(frames), frames, 0.0)
-        ids = generated_ids(args.n_sequences, args.n_frames)
-        verdict = split.judge.verdict(frames, sequence_ids=ids)
-        judged = verdict.starts >= JUDGED_FROM
-        later = np.tile(np.arange(args.n_frames) >= JUDGED_FROM, args.n_sequences)
-        frames, ids = frames[later], ids[later]
+        verdict, frames, ids, blown = judged_blend(candidate, split, weights, args, rng)
         speed = forward_speed(frames, sequence_ids=ids, feature_names=names)
         frequency = step_frequency(
             frames, sequence_ids=ids, features=split.legs, frame_rate=FRAME_RATE
         )
-        one_of_two = np.isin(verdict.predicted[judged], [first, second]).mean()
+        one_of_two = np.isin(verdict.predicted, [first, second]).mean()
         cells[f"{first}/{second}"] = dict(
             one_of_two=float(one_of_two),
             speed_between=_between(np.mean(speed), split.real_speed, first, second),
@@ -539,6 +533,22 @@ def blends(candidate, split, args, rng):
             blown_up=int(blown.sum()),
         )
     return cells
+
+
+def judged_blend(candidate, split, weights, args, rng):
+    """Sequences following the label ``weights``, seeded with a normal walk:
+    the judge's verdict of the windows from JUDGED_FROM on (each alive against
+    the style it is judged as), the frames and sequence ids from JUDGED_FROM
+    on, and which sequences blew up."""
+    frames = generate(candidate, split, weights, NORMAL, args, rng)
+    blown = _blown_up(split, frames, args.n_sequences)
+    frames = np.where(np.isfinite(frames), frames, 0.0)
+    ids = generated_ids(args.n_sequences, args.n_frames)
+    verdict = split.judge.verdict(frames, sequence_ids=ids)
+    judged = verdict.starts >= JUDGED_FROM
+    verdict = Bunch(**{key: value[judged] for key, value in verdict.items()})
+    later = np.tile(np.arange(args.n_frames) >= JUDGED_FROM, args.n_sequences)
+    return verdict, frames[later], ids[later], blown
 
 
 def _between(value, real, first, second, margin=0.1):
@@ -985,24 +995,31 @@ def _params_tag(args):
     return "_" + hashlib.sha1(text).hexdigest()[:8]
 
 
+def fitted_candidate(name, split, args, seed):
+    """``(candidate, training seconds)``, trained on the split's training frames,
+    or loaded from ``args.models`` (NaN seconds) where an earlier run saved it."""
+    candidate = CANDIDATES[name](args.params)
+    saved = Path(args.models or "") / f"{name}_seed{seed}{_params_tag(args)}.joblib"
+    if args.models and saved.exists():  # fitted by an earlier run
+        vars(candidate).update(joblib.load(saved))
+        print(f"  {name}, seed {seed}: loaded {saved}", flush=True)
+        return candidate, float("nan")
+    Z, styles, ids = split.frames(split.train)
+    fit = partial(candidate.fit, Z, styles, ids, seed=seed, n_iter=args.n_iter)
+    fit_seconds = seconds(fit)
+    print(f"  {name}, seed {seed}: trained in {fit_seconds:.0f} s", flush=True)
+    if args.models:  # to look at what it generates, or measure more parts
+        saved.parent.mkdir(parents=True, exist_ok=True)
+        joblib.dump(vars(candidate), saved)
+    return candidate, fit_seconds
+
+
 def run_candidate(name, walks, split, args, seed):
     Z, styles, ids = split.frames(split.train)
     rng = np.random.default_rng(seed)
     if set(args.parts) == {"one-take"}:  # its splits train their own models
         return {"one-take": one_take(name, walks, args, seed, rng)}
-    candidate = CANDIDATES[name](args.params)
-    saved = Path(args.models or "") / f"{name}_seed{seed}{_params_tag(args)}.joblib"
-    if args.models and saved.exists():  # fitted by an earlier run
-        vars(candidate).update(joblib.load(saved))
-        fit_seconds = float("nan")
-        print(f"  {name}, seed {seed}: loaded {saved}", flush=True)
-    else:
-        fit = partial(candidate.fit, Z, styles, ids, seed=seed, n_iter=args.n_iter)
-        fit_seconds = seconds(fit)
-        print(f"  {name}, seed {seed}: trained in {fit_seconds:.0f} s", flush=True)
-        if args.models:  # to look at what it generates, or measure more parts
-            saved.parent.mkdir(parents=True, exist_ok=True)
-            joblib.dump(vars(candidate), saved)
+    candidate, fit_seconds = fitted_candidate(name, split, args, seed)
     n_iter = candidate.n_epochs()
     measures = {  # in this order: they draw from one random stream
         "style": lambda: style_kept(candidate, split, args, rng),
