@@ -133,7 +133,7 @@ def _small_models():
     yield LabelledCRBM(5, order=2, n_iter=1, random_state=0)
 
 
-@pytest.mark.parametrize("model", _small_models(), ids=lambda m: type(m).__name__)
+@pytest.mark.parametrize("model", list(_small_models()), ids=lambda m: type(m).__name__)
 def test_every_model_has_a_work_estimate(model):
     """Before and after fit, the product size is the layers' (never 0)."""
     X, ids = make_oscillations(n_sequences=2, n_frames=30, n_features=4, random_state=0)
