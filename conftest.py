@@ -19,3 +19,20 @@ from hypothesis import settings  # noqa: E402
 settings.register_profile("repeatable", derandomize=True, database=None)
 settings.register_profile("explore", derandomize=False)
 settings.load_profile("repeatable")
+
+
+def pytest_report_header(config):
+    """The versions this run tests with, so every log says what it saw."""
+    from importlib import metadata
+
+    names = [
+        "numpy", "scipy", "scikit-learn", "joblib", "threadpoolctl", "matplotlib",
+        "pandas", "dask", "hypothesis", "sphinx", "array-api-strict", "torch",
+    ]  # fmt: skip
+    versions = []
+    for name in names:
+        try:
+            versions.append(f"{name} {metadata.version(name)}")
+        except metadata.PackageNotFoundError:
+            versions.append(f"{name} (not installed)")
+    return "tested with: " + ", ".join(versions)

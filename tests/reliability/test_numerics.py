@@ -144,8 +144,8 @@ def test_paper_settings_stay_finite_on_cmu35(dtype, cmu_preprocessed, factories)
         assert np.isfinite(out).all(), name
     # log-likelihood per frame above that of independent standard normals
     assert np.isfinite(score) and score > -62 * (0.5 * np.log(2 * np.pi) + 0.5)
-    # generated frames stay within the range of standardised data
-    assert np.abs(outputs["sample"]).max() < 20
+    # generated frames stay within the range of the standardised training data
+    assert np.abs(outputs["sample"]).max() <= np.abs(Z).max()
 
 
 # The style models at sizes a user of the CMU data would start from, walks
@@ -186,7 +186,10 @@ def test_style_models_stay_finite_on_cmu35(
     mean = outputs["score_samples"].mean()
     assert mean > -62 * (0.5 * np.log(2 * np.pi) + 0.5)
     np.testing.assert_allclose(outputs["predict_proba"].sum(axis=1), 1, rtol=1e-5)
-    assert np.abs(outputs["sample"]).max() < 20
+    # Within the range of the training data, which a glitch in jog 35_19 takes
+    # to |z| = 26 on the thumbs: asked for a jog from a walk's frames, the
+    # balanced factored model holds that pose (22.7 in float32), bounded.
+    assert np.abs(outputs["sample"]).max() <= np.abs(Z).max()
 
 
 # ------------------------------------------------------------ large inputs

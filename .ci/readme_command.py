@@ -1,0 +1,28 @@
+"""Print a command of README.md's Quick start, so that CI runs it as written.
+
+    python .ci/readme_command.py demo   # the first command: install, run the demo
+    python .ci/readme_command.py test   # the second command: install, run the tests
+    python .ci/readme_command.py venv   # the first command's virtual environment step
+"""
+
+import re
+import sys
+from pathlib import Path
+
+
+def quick_start_commands(readme):
+    """The commands of the first ``bash`` block under the Quick start heading."""
+    section = readme.split("## Quick start", 1)[1]
+    block = re.search(r"```bash\n(.*?)```", section, re.DOTALL).group(1)
+    return [line for line in block.splitlines() if line and not line.startswith("#")]
+
+
+def main(which):
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    demo, test = quick_start_commands(readme)
+    commands = {"demo": demo, "test": test, "venv": demo.split(" && ")[0]}
+    print(commands[which])
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
