@@ -183,8 +183,9 @@ def _forward(skeleton, positions, horizontal):
 # drawn left to right and bottom to top.
 VIEWS = ("auto", "front", "side", "top")
 _PICTURE_AXES = {"side": (0, 2), "front": (1, 2), "top": (0, 1)}
-# "auto" looks from above at motion that spreads less than this up and down
-# than along the ground (walks and runs: 0.67 to 2.3; a turn: 0.08).
+# "auto" looks from above at motion whose joints spread up and down less than
+# this times as much as along either ground axis (on real takes, walks and
+# runs: 0.67 to 2.3; a turn: 0.08).
 TOP_SPREAD = 1 / 3
 
 
