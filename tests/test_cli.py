@@ -4,10 +4,11 @@ import argparse
 import io
 import re
 import sys
-import tempfile
+import warnings
 from contextlib import redirect_stdout
 from pathlib import Path
 
+import joblib
 import numpy as np
 import pytest
 import sklearn
@@ -15,7 +16,6 @@ from numpy.testing import assert_allclose, assert_array_equal
 from PIL import Image
 
 from sklearn_crbm.cli import _main as _cli
-from sklearn_crbm.cli import _options as _cli_options
 from sklearn_crbm.cli import _style_demo, main
 from sklearn_crbm.datasets import (
     bone_columns,
@@ -141,12 +141,30 @@ def test_demo_writes_the_motion_without_figures(
         assert "matplotlib is not installed" in out
 
 
-@pytest.mark.parametrize("command", ["demo", "styles"])
-def test_demo_writes_outside_the_current_folder_by_default(command):
-    output = _cli._parser().parse_args([command]).output
-    assert output == Path(tempfile.gettempdir()) / f"sklearn_crbm_{command}"
-    assert output in (_cli_options.DEMO_OUTPUT, _cli_options.STYLES_OUTPUT)
-    assert Path.cwd().resolve() not in output.resolve().parents
+@pytest.mark.parametrize("command", ["demo", "styles", "sample"])
+def test_output_is_a_folder_of_the_current_folder_by_default(command):
+    """Not one folder of the temporary directory shared by every user and
+    run of the machine (issue 50.3)."""
+    argv = [command] + ["m.joblib"] * (command == "sample")
+    output = _cli._parser().parse_args(argv).output
+    assert output == Path("sklearn_crbm_output") / command
+    assert not output.is_absolute()
+
+
+def test_sample_writes_into_its_output_folder_and_says_where(
+    data_home, tmp_path, capsys, monkeypatch
+):
+    model = tmp_path / "model.joblib"
+    main(["fit", "--data-home", str(data_home), "--output", str(model), *TINY])
+    monkeypatch.chdir(tmp_path)
+    assert main(["sample", str(model), "--n-frames", "12"]) == 0
+    out = capsys.readouterr().out
+    folder = tmp_path / "sklearn_crbm_output" / "sample"
+    assert f"generated motion goes to {folder}" in out
+    assert sorted(p.name for p in folder.iterdir()) == [
+        "generated_0.amc",
+        "generated_0.bvh",
+    ]
 
 
 def test_fit_then_sample_needs_no_data(data_home, tmp_path, capsys, monkeypatch):
@@ -167,10 +185,10 @@ def test_fit_then_sample_needs_no_data(data_home, tmp_path, capsys, monkeypatch)
         )
         assert status == 0, capsys.readouterr().err
         for k in (0, 1):
-            data, _ = read_amc(f"{prefix}_{k}.amc", skeleton)
+            data, _ = read_amc(prefix / f"generated_{k}.amc", skeleton)
             assert data.shape == (25, 62)
             # the BVH file holds the same motion
-            written, bvh, _, rate = read_bvh(f"{prefix}_{k}.bvh")
+            written, bvh, _, rate = read_bvh(prefix / f"generated_{k}.bvh")
             assert rate == 30.0
             ends = skeleton.forward_kinematics(data)
             joints = written.forward_kinematics(bvh)
@@ -201,7 +219,7 @@ def test_sample_seeds_each_style_from_that_style(data_home, tmp_path, capsys):
 
 
 def _fit_and_sample(folder, tmp_path, capsys):
-    """Fit on ``folder``, sample 12 frames; the fit's report and the prefix."""
+    """Fit on ``folder``, sample 12 frames; the fit's report and the output."""
     model = tmp_path / "mine.joblib"
     assert main(["fit", str(folder), "--output", str(model), *TINY]) == 0
     report = capsys.readouterr().out
@@ -219,9 +237,9 @@ def test_fit_reads_a_folder_of_bvh_files(tmp_path, capsys):
         write_bvh(folder / f"walk_{seed}.bvh", walker.data, walker.skeleton, 60.0)
     report, prefix = _fit_and_sample(folder, tmp_path, capsys)
     assert "training on 80 frames of 2 sequences at 30 frames/s" in report
-    skeleton, data, _, rate = read_bvh(f"{prefix}_0.bvh")
+    skeleton, data, _, rate = read_bvh(prefix / "generated_0.bvh")
     assert data.shape[0] == 12 and rate == 30.0
-    assert not (tmp_path / "generated_0.amc").exists()  # BVH skeletons: no AMC
+    assert not (prefix / "generated_0.amc").exists()  # BVH skeletons: no AMC
 
 
 def test_fit_reads_a_folder_of_asf_amc_files(data_home, tmp_path, capsys):
@@ -232,8 +250,8 @@ def test_fit_reads_a_folder_of_asf_amc_files(data_home, tmp_path, capsys):
     report, prefix = _fit_and_sample(folder, tmp_path, capsys)
     assert "training on 90 frames of 1 sequence at 30 frames/s" in report
     skeleton = load_cmu35(data_home, subset="test").skeleton
-    assert read_amc(f"{prefix}_0.amc", skeleton)[0].shape == (12, 62)
-    assert (tmp_path / "generated_0.bvh").exists()
+    assert read_amc(prefix / "generated_0.amc", skeleton)[0].shape == (12, 62)
+    assert (prefix / "generated_0.bvh").exists()
 
 
 def test_fit_says_what_a_folder_lacks(tmp_path, capsys):
@@ -553,8 +571,8 @@ def test_fit_labels_keep_seeds_of_each_label_for_sample(tmp_path, capsys, labels
     argv = ["sample", str(model), "--style", "fast", "--n-frames", "12"]
     argv += ["--n-sequences", "2", "--output", str(prefix), "--animate"]
     assert main(argv) == 0
-    assert read_bvh(f"{prefix}_1.bvh")[1].shape[0] == 12
-    assert Image.open(f"{prefix}.gif").n_frames == 12
+    assert read_bvh(prefix / "generated_1.bvh")[1].shape[0] == 12
+    assert Image.open(prefix / "generated.gif").n_frames == 12
 
 
 def test_styles_runs_on_a_users_labelled_folder(tmp_path, capsys):
@@ -627,7 +645,7 @@ def test_sample_generates_at_the_speed_asked(speed_model, tmp_path, capsys):
         argv = ["sample", str(model), "--speed", speed, "--n-frames", "12"]
         assert main([*argv, "--output", str(prefix)]) == 0
         assert re.search(r"forward speed -?\d+\.\d\)", capsys.readouterr().out)
-        frames[name] = read_bvh(f"{prefix}_0.bvh")[1]
+        frames[name] = read_bvh(prefix / "generated_0.bvh")[1]
     assert_array_equal(frames["a"], frames["b"])
     assert not np.allclose(frames["a"], frames["c"])
     assert not np.allclose(frames["a"], frames["d"])
@@ -644,3 +662,125 @@ def test_sample_speed_needs_a_model_fitted_with_it(speed_model, tmp_path, capsys
     assert main(argv) == 1
     err = capsys.readouterr().err
     assert "fitted without speed as context: fit it with --speed-context" in err
+
+
+# -- what the command line says: warnings, verdicts, seeds (issues 46, 48, 50) --
+
+
+def test_warnings_are_the_commands_own_lines(capsys, monkeypatch):
+    """Not Python's ``<frozen runpy>:88: GenerationWarning: ...`` (issue 48.3)."""
+    from sklearn_crbm.exceptions import GenerationWarning
+
+    def warn(args):
+        warnings.warn("Sequence 0 of 1 died out.", GenerationWarning, stacklevel=2)
+        return 0
+
+    monkeypatch.setitem(_cli._RUNS, "fetch", warn)
+    assert main(["fetch"]) == 0
+    assert capsys.readouterr().err == "warning: Sequence 0 of 1 died out.\n"
+
+
+@pytest.fixture(scope="module")
+def walker_model(tmp_path_factory):
+    """``(model, folder)``: a tiny model fitted on a folder of walker takes."""
+    tmp_path = tmp_path_factory.mktemp("walker_model")
+    folder = _walker_folder(tmp_path / "mine", 30.0, n_frames=60)
+    model = tmp_path / "m.joblib"
+    with redirect_stdout(io.StringIO()):
+        assert main(["fit", str(folder), *TINY, "--output", str(model)]) == 0
+    return model, folder
+
+
+def test_sample_says_once_that_a_sequence_came_to_rest(walker_model, tmp_path, capsys):
+    """One line per file with its verdict, no GenerationWarning repeating it,
+    and advice the command line can follow (issues 50.6, 46.4)."""
+    saved = joblib.load(walker_model[0])
+    crbm = saved["pipeline"][-1]
+    for name in ("components_", "autoregressive_", "past_to_hidden_"):
+        setattr(crbm, name, np.zeros_like(getattr(crbm, name)))  # frozen
+    still = tmp_path / "still.joblib"
+    joblib.dump(saved, still)
+    argv = ["sample", str(still), "--n-frames", "120", "--n-sequences", "2"]
+    assert main([*argv, "--output", str(tmp_path / "out")]) == 0
+    out, err = capsys.readouterr()
+    assert (out + err).count("came to rest") == 2  # one per sequence
+    assert "wrote generated_0.bvh (seeded with training frames; lively 0.00: " in out
+    assert err == ""  # no warning saying it again
+    assert "--seed-file PATH --seed-frame N" in out
+    assert "history=" not in out
+
+
+def test_sample_seeds_from_a_take_of_ones_own(walker_model, tmp_path, capsys):
+    model, folder = walker_model
+    take = folder / "walk_fast_001.bvh"
+    argv = ["sample", str(model), "--n-frames", "12", "--output", str(tmp_path)]
+    assert main([*argv, "--seed-file", str(take), "--seed-frame", "20"]) == 0
+    assert "(seeded with frames 18-20 of walk_fast_001.bvh; lively" in (
+        capsys.readouterr().out
+    )
+    saved = _cli._load_model(model)
+    args = _cli._parser().parse_args(
+        [*argv, "--seed-file", str(take), "--seed-frame", "20", "--n-sequences", "2"]
+    )
+    history, _ = _cli._seeds(saved, args)
+    Z = saved.pipeline[:-1].transform(read_bvh(take)[1])
+    assert history.shape == (2, 3, Z.shape[1])
+    assert_allclose(history[0], Z[18:21])
+    assert_allclose(history[1], Z[18:21])
+    # a take at twice the model's rate: every other frame, ending at the frame
+    fast = tmp_path / "fast.bvh"
+    skeleton, data, _, _ = read_bvh(take)
+    write_bvh(fast, np.repeat(data, 2, axis=0), skeleton, 60.0)
+    args.seed_file, args.seed_frame = fast, 41
+    history, text = _cli._seeds(saved, args)
+    assert text == "seeded with frames 37-41 of fast.bvh"
+    assert_allclose(history[0], Z[18:21], atol=1e-8)
+    # the take's middle frame by default
+    args.seed_file, args.seed_frame = take, None
+    assert (
+        _cli._seeds(saved, args)[1] == "seeded with frames 28-30 of walk_fast_001.bvh"
+    )
+
+
+@pytest.mark.parametrize(
+    "extra, message",
+    [
+        (["--seed-frame", "5"], "--seed-frame N picks a frame of --seed-file PATH"),
+        (["--seed-file", "{take}", "--seed-frame", "60"], "has frames 0 to 59"),
+        (["--seed-file", "{take}", "--seed-frame", "1"], "end at frame 2 of"),
+        (["--seed-file", "{take}", "--style", "fast"], "give one"),
+        (["--seed-file", "{other}"], "is not of the model's skeleton"),
+        (["--seed-file", "{missing}"], "is not a file"),
+    ],
+)
+def test_sample_seed_file_errors_say_what_to_do(
+    walker_model, tmp_path, capsys, data_home, extra, message
+):
+    model, folder = walker_model
+    paths = dict(
+        take=folder / "walk_fast_001.bvh",
+        other=data_home / "bandai_contents" / "dataset-2_walk_normal_001.bvh",
+        missing=tmp_path / "none.bvh",
+    )
+    extra = [part.format(**paths) for part in extra]
+    argv = ["sample", str(model), "--output", str(tmp_path), *extra]
+    assert main(argv) == 1
+    assert message in capsys.readouterr().err
+
+
+def test_every_drawing_command_takes_a_view(walker_model, tmp_path, monkeypatch):
+    parser = _cli._parser()
+    for argv in (["demo"], ["styles"], ["sample", "m.joblib"]):
+        assert parser.parse_args(argv).view == "auto"
+        assert parser.parse_args([*argv, "--view", "front"]).view == "front"
+    seen = []
+    real = _cli.save_gif
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs["view"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(_cli, "save_gif", spy)
+    argv = ["sample", str(walker_model[0]), "--n-frames", "4", "--animate"]
+    assert main([*argv, "--output", str(tmp_path), "--view", "top"]) == 0
+    assert seen == ["top"]

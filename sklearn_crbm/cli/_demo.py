@@ -7,12 +7,14 @@ jogging, and draw figures; all measuring is done by the library
 """
 
 import time
+import warnings
 
 import numpy as np
 from sklearn.impute import KNNImputer
 
 from .._base import DEAD_FRACTION, generated_liveliness
 from ..datasets import write_amc, write_bvh
+from ..exceptions import GenerationWarning
 from ..impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from ..metrics import judge_generated_motion
 from ..model_selection import compare_imputers, make_fillin_cases
@@ -166,7 +168,10 @@ def _generate_styles(model, preprocessor, Z, train, args):
             sequences=np.flatnonzero(styles == style),
             random_state=rng,
         )
-        frames = model.sample(args.n_frames, history=seeds, random_state=args.seed)
+        with warnings.catch_warnings():
+            # the table gives every sequence's verdict, once
+            warnings.simplefilter("ignore", GenerationWarning)
+            frames = model.sample(args.n_frames, history=seeds, random_state=args.seed)
         gen_ids = np.repeat(np.arange(N_PER_STYLE), args.n_frames)
         verdict = judge_generated_motion(
             frames,
@@ -251,14 +256,21 @@ def _draw(args, imputer, preprocessor, Z_train, train, cases, generated):
         )
         return []
     output = args.output
-    written = [_real_and_generated_gif(output, preprocessor, train, generated)]
+    written = [
+        _real_and_generated_gif(output, preprocessor, train, generated, args.view)
+    ]
     for style, (frames, gen_ids) in generated.items():
         raw = preprocessor.inverse_transform(frames, sequence_ids=gen_ids)
         first = raw[gen_ids == 0]
         step = -(-len(first) // STRIP_FIGURES)
         fig, ax = plt.subplots(figsize=(14, 3))
         plot_motion_strip(
-            train.skeleton, first, feature_names=train.feature_names, step=step, ax=ax
+            train.skeleton,
+            first,
+            feature_names=train.feature_names,
+            step=step,
+            view=args.view,
+            ax=ax,
         )
         ax.set_title(
             f"generated from a {style} seed: all {len(first)} frames, one "
@@ -289,7 +301,7 @@ def _draw(args, imputer, preprocessor, Z_train, train, cases, generated):
     return written
 
 
-def _real_and_generated_gif(output, preprocessor, train, generated):
+def _real_and_generated_gif(output, preprocessor, train, generated, view):
     """A real trial of each style beside the first sequence generated from it."""
     motion = np.asarray(train.motion)
     sequences, titles = [], []
@@ -306,6 +318,7 @@ def _real_and_generated_gif(output, preprocessor, train, generated):
         titles=titles,
         frame_rate=train.frame_rate,
         step=GIF_STEP,
+        view=view,
     )
 
 

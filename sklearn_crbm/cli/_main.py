@@ -10,14 +10,14 @@ import argparse
 import re
 import shutil
 import sys
-from pathlib import Path
+import warnings
 
 import joblib
 import numpy as np
 import sklearn
 from sklearn.utils import Bunch
 
-from .._base import generated_liveliness
+from .._base import DEAD_FRACTION, generated_liveliness, lifeless_message
 from .._crbm import ConditionalRBM
 from .._factored import FactoredCRBM
 from ..datasets import (
@@ -31,10 +31,12 @@ from ..datasets import (
     read_bvh_folder,
     resample_frames,
 )
+from ..exceptions import GenerationWarning
 from ..preprocessing import MotionContext, MotionPipeline, make_motion_pipeline
 from ._demo import liveliness_text, save_gif
 from ._demo import run_demo as _run_demo
 from ._options import COMMANDS, MAX_DEFAULT_RATE
+from ._seed_file import seed_from_file
 from ._style_demo import run_styles as _run_styles
 
 __all__ = ["main"]
@@ -50,12 +52,25 @@ def main(argv=None):
     if args.command is None:
         parser.print_help()
         return 2
+    if getattr(args, "output", None) is not None:
+        args.output = args.output.absolute()  # printed: say where it is
     try:
         with sklearn.config_context(enable_metadata_routing=True):
-            return args.run(args)
+            with warnings.catch_warnings():
+                warnings.showwarning = _show_warning
+                return args.run(args)
     except (ImportError, OSError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 1
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """A warning as the command's own line, ``warning: ...`` on stderr.
+
+    (Python's own format names the first frame outside the package, which
+    for ``python -m`` is ``<frozen runpy>:88``.)
+    """
+    print(f"warning: {message}", file=sys.stderr)
 
 
 def _parser():
@@ -314,32 +329,45 @@ def _load_model(path):
 def run_sample(args):
     saved = _load_model(args.model)
     pipeline = saved.pipeline
-    raw = pipeline.sample(
-        args.n_frames,
-        history=_seeds(saved, args),
-        n_sequences=args.n_sequences,
-        hidden_noise=args.hidden_noise,
-        random_state=args.seed,
-        **_speed_request(saved, args),
-    )
+    history, seeded = _seeds(saved, args)
+    with warnings.catch_warnings():
+        # every sequence's verdict is printed beside its file, once
+        warnings.simplefilter("ignore", GenerationWarning)
+        raw = pipeline.sample(
+            args.n_frames,
+            history=history,
+            n_sequences=args.n_sequences,
+            hidden_noise=args.hidden_noise,
+            random_state=args.seed,
+            **_speed_request(saved, args),
+        )
     suffixes = [".bvh"] + [".amc"] * (pipeline.skeleton.convention == "acclaim")
-    lively = _liveliness(pipeline, raw, args.n_frames)
+    verdicts, failed = _verdicts(pipeline, raw, args.n_frames)
     sequences = np.split(raw, args.n_sequences)
+    args.output.mkdir(parents=True, exist_ok=True)
+    print(f"generated motion goes to {args.output} (--output to change)")
     for k, sequence in enumerate(sequences):
         measured = _speed_text(saved, sequence)
         for suffix in suffixes:
-            path = Path(f"{args.output}_{k}{suffix}")
+            path = args.output / f"generated_{k}{suffix}"
             pipeline.write_motion(path, sequence, frame_rate=saved.frame_rate)
-            print(f"wrote {path} ({liveliness_text(lively[k])}{measured})")
+            print(f"wrote {path.name} ({seeded}; {verdicts[k]}{measured})")
+    if failed:
+        print(
+            "  to keep generated motion moving, seed it with real frames of the "
+            "motion wanted (--style, or --seed-file PATH --seed-frame N), or fit "
+            "for longer (fit --n-iter) or on more takes"
+        )
     if args.animate:
         path = save_gif(
-            Path(f"{args.output}.gif"),
+            args.output / "generated.gif",
             pipeline.skeleton,
             sequences,
-            titles=[f"{args.output.name}_{k}" for k in range(len(sequences))],
+            titles=[f"generated_{k}" for k in range(len(sequences))],
             frame_rate=saved.frame_rate,
+            view=args.view,
         )
-        print(f"wrote {path}")
+        print(f"wrote {path.name}")
     return 0
 
 
@@ -370,30 +398,59 @@ def _speed_text(saved, sequence):
     return f", forward speed {saved.speed.transform(sequence).mean():.1f}"
 
 
-def _liveliness(pipeline, raw, n_frames):
-    """:func:`generated_liveliness` of generated raw channels, per sequence."""
-    ids = np.repeat(np.arange(len(raw) // n_frames), n_frames)
-    Z = pipeline[:-1].transform(raw, sequence_ids=ids)
+def _verdicts(pipeline, raw, n_frames):
+    """Each generated sequence's verdict, and whether any failed.
+
+    ``"lively 0.93"``, ``"lively 0.00: came to rest"`` (below
+    ``DEAD_FRACTION``) or ``"blew up"``, judged as the model's
+    :class:`GenerationWarning` judges them (``lively -`` for a model saved
+    by a version that kept no statistics).
+    """
+    n_sequences = len(raw) // n_frames
     statistics = getattr(pipeline[-1], "generation_statistics_", None)
-    if statistics is None:  # saved by a version that kept no statistics
-        return np.full(ids[-1] + 1, np.nan)
-    return generated_liveliness(Z, n_frames, statistics)
+    if statistics is None:
+        return [liveliness_text(np.nan)] * n_sequences, False
+    ids = np.repeat(np.arange(n_sequences), n_frames)
+    Z = pipeline[:-1].transform(raw, sequence_ids=ids)
+    lively = generated_liveliness(Z, n_frames, statistics)
+    verdicts = []
+    for k in range(n_sequences):
+        blown = "blew up" in lifeless_message(Z[ids == k], n_frames, statistics)
+        verdicts.append("blew up" if blown else liveliness_text(lively[k]))
+    failed = any(v == "blew up" for v in verdicts) or bool(
+        np.any(lively < DEAD_FRACTION)
+    )
+    return verdicts, failed
 
 
 def _seeds(saved, args):
-    """``sample``'s history: saved windows of the chosen style (None: any)."""
+    """``sample``'s history and what it is: saved windows of the chosen
+    style, frames of ``--seed-file``, or None (the model's own windows)."""
+    if args.seed_frame is not None and args.seed_file is None:
+        raise ValueError("--seed-frame N picks a frame of --seed-file PATH: give both.")
+    if args.seed_file is not None:
+        if args.style is not None:
+            raise ValueError(
+                "--style and --seed-file both choose the seed frames: give one."
+            )
+        seed = seed_from_file(
+            saved.pipeline, saved.frame_rate, args.seed_file, args.seed_frame
+        )
+        history = np.repeat(seed.window[None], args.n_sequences, axis=0)
+        return history, f"seeded with {seed.text}"
     if args.style is None:
-        return None
+        return None, "seeded with training frames"
     if args.style not in saved.seed_windows:
         known = ", ".join(saved.seed_windows) or "none"
         raise ValueError(
             f"{args.model} keeps no seed frames of style {args.style!r} (its "
             f"styles: {known}); leave --style out to seed from every training "
-            "sequence."
+            "sequence, or seed from a take of your own with --seed-file."
         )
     windows = saved.seed_windows[args.style]
     rng = np.random.default_rng(args.seed)
-    return windows[rng.integers(len(windows), size=args.n_sequences)]
+    chosen = windows[rng.integers(len(windows), size=args.n_sequences)]
+    return chosen, f"seeded with {args.style} frames"
 
 
 def run_styles(args):

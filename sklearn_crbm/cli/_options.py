@@ -2,18 +2,18 @@
 
 import argparse
 import math
-import tempfile
 from pathlib import Path
 
 from .._crbm import ConditionalRBM
 from .._factored import FactoredCRBM
+from ..plotting._skeleton import VIEWS
 
-__all__ = ["COMMANDS", "DEMO_OUTPUT", "STYLES_OUTPUT"]
+__all__ = ["COMMANDS", "OUTPUT"]
 
-# The demo and the styles command write here unless --output says otherwise:
-# never into the current folder, which in a checkout is the repository.
-DEMO_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_demo"
-STYLES_OUTPUT = Path(tempfile.gettempdir()) / "sklearn_crbm_styles"
+# The commands that write figures and motion write into OUTPUT / command in
+# the current folder unless --output says otherwise: one user's runs in one
+# place of their own, never shared with other users of the machine.
+OUTPUT = Path("sklearn_crbm_output")
 # The model options default to the estimators' own defaults.
 _DEFAULTS = ConditionalRBM()
 
@@ -102,6 +102,26 @@ _FRAME_RATE = _option(
     f"the files' own rate, at most {MAX_DEFAULT_RATE:g}; AMC files are read as "
     "120 frames/s, CMU's rate)",
 )
+_VIEW = _option(
+    "--view",
+    choices=VIEWS,
+    default="auto",
+    help="where the figures and GIFs look from: auto faces the plane in which "
+    "the motion moves most (a walk from the side, a hand wave from the front, "
+    "a turn from above); front, side or top",
+)
+
+
+def _output(command, what):
+    """``--output DIR`` of a command that writes files."""
+    return _option(
+        "--output",
+        type=Path,
+        default=OUTPUT / command,
+        help=f"folder for {what}, made if missing",
+    )
+
+
 _MODEL_OPTIONS = [
     _option(
         "--n-components", type=_count(1), default=200, help="hidden units of the CRBM"
@@ -191,13 +211,8 @@ COMMANDS = {
         [
             _DATA_HOME,
             *_MODEL_OPTIONS,
-            _option(
-                "--output",
-                type=Path,
-                default=DEMO_OUTPUT,
-                help="folder for the figures and the generated motion (BVH and "
-                "AMC files)",
-            ),
+            _output("demo", "the figures and the generated motion (BVH and AMC files)"),
+            _VIEW,
             _option(
                 "--n-repeats",
                 type=_count(1),
@@ -292,8 +307,8 @@ COMMANDS = {
         "generate motion from a saved model and write BVH (and AMC) files",
         "Generate motion from a model saved by the fit command and write one "
         "BVH file per sequence, and an AMC file beside it when the model was "
-        "trained on ASF/AMC files. The seed frames are saved with the model: "
-        "no data is read.",
+        "trained on ASF/AMC files. The seed frames are saved with the model, "
+        "or come from a take of your own (--seed-file).",
         [
             _option("model", type=Path, help="a file written by the fit command"),
             _option(
@@ -301,6 +316,22 @@ COMMANDS = {
                 help="seed each sequence with real frames of this style ('walk' "
                 "or 'jog' for CMU 35); default: the model's own seed windows, "
                 "from every training sequence",
+            ),
+            _option(
+                "--seed-file",
+                type=Path,
+                metavar="PATH",
+                help="seed every sequence with real frames of this take of your "
+                "own (a BVH file of the model's skeleton, or an AMC file for a "
+                "model fitted on ASF/AMC): the generated motion continues it "
+                "after --seed-frame",
+            ),
+            _option(
+                "--seed-frame",
+                type=_count(0),
+                metavar="N",
+                help="with --seed-file: the last real frame, counted from 0 at "
+                "the file's own rate (default: the take's middle frame)",
             ),
             _option(
                 "--speed",
@@ -328,18 +359,18 @@ COMMANDS = {
                 default=0,
                 help="random seed of the seeds and sampling",
             ),
-            _option(
-                "--output",
-                type=Path,
-                default=Path("generated"),
-                help="prefix of the files written (PREFIX_0.bvh, PREFIX_1.bvh, ...)",
+            _output(
+                "sample",
+                "the generated motion (generated_0.bvh, generated_1.bvh, ... and "
+                "generated.gif)",
             ),
             _option(
                 "--animate",
                 action="store_true",
-                help="also write PREFIX.gif: the generated sequences moving side "
+                help="also write generated.gif: the generated sequences moving side "
                 "by side (needs matplotlib and pillow)",
             ),
+            _VIEW,
         ],
     ),
     "styles": (
@@ -375,12 +406,8 @@ COMMANDS = {
             ),
             _FRAME_RATE,
             *_FACTORED_OPTIONS,
-            _option(
-                "--output",
-                type=Path,
-                default=STYLES_OUTPUT,
-                help="folder for the BVH files and the figures",
-            ),
+            _output("styles", "the BVH files and the figures"),
+            _VIEW,
             _option(
                 "--n-frames",
                 type=_count(1),

@@ -276,7 +276,9 @@ def _draw(walks, generated, judge, judged, args):
         else:
             fig, ax = plt.subplots(figsize=(12, 2.6))
             last = first[-STRIP_FRAMES:]
-            plot_motion_strip(walks.skeleton, last, step=STRIP_STEP, ax=ax)
+            plot_motion_strip(
+                walks.skeleton, last, step=STRIP_STEP, view=args.view, ax=ax
+            )
             ax.set_title(
                 f"{name.replace('_', ' ')}: every {STRIP_STEP}th of the last "
                 f"{len(last)} of {len(first)} generated frames"
@@ -291,7 +293,7 @@ def _gifs(walks, generated, judge, judged, args):
     last = [
         generated[style][0][generated[style][1] == 0][-GIF_FRAMES:] for style in styles
     ]
-    common = dict(frame_rate=walks.frame_rate, step=GIF_STEP)
+    common = dict(frame_rate=walks.frame_rate, step=GIF_STEP, view=args.view)
     written = [
         save_gif(
             args.output / "styles.gif",
@@ -324,7 +326,7 @@ def _draw_transition(walks, raw, judge, generated, args):
     a, b = args.transition
     switch = args.n_frames // 2
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(12, 6))
-    plot_motion_strip(walks.skeleton, raw, ax=top)
+    plot_motion_strip(walks.skeleton, raw, view=args.view, ax=top)
     top.set_title(f"{a}, then {b} from frame {switch}: the whole sequence")
     plot_style_probabilities(
         _first_sequence_proba(judge, generated),

@@ -116,15 +116,18 @@ def _hips(skeleton, positions, ground):
 def _facings(skeleton, positions, up, ground):
     """Per-frame ground-plane unit vector perpendicular to the hips.
 
-    The sign is kept continuous from frame to frame and chosen so that the
-    body mostly moves along it; without hips the first ground axis is used.
+    The way the body faces when the first of the two hips is its left
+    (``across x up``, right-handed axes); the sign is kept continuous from
+    frame to frame and chosen so that the body mostly moves along it.
+    Without hips the first ground axis is used.
     """
     pair = _hips(skeleton, positions, ground)
     if pair is None:
         return np.tile([1.0, 0.0], (len(positions), 1))
-    across = positions[:, pair[0], ground] - positions[:, pair[1], ground]
-    across /= np.maximum(np.linalg.norm(across, axis=1, keepdims=True), 1e-12)
-    facing = np.column_stack([-across[:, 1], across[:, 0]])
+    across = positions[:, pair[0]] - positions[:, pair[1]]
+    across[:, up] = 0.0
+    facing = np.cross(across, np.eye(3)[up])[:, ground]
+    facing /= np.maximum(np.linalg.norm(facing, axis=1, keepdims=True), 1e-12)
     for k in range(1, len(facing)):
         if facing[k] @ facing[k - 1] < 0:
             facing[k] = -facing[k]
@@ -139,10 +142,23 @@ def _facing(skeleton, positions, up, ground):
     return _facings(skeleton, positions[:1], up, ground)[0]
 
 
-def _horizontal(skeleton, positions, horizontal):
-    """Unit ground-plane direction drawn left to right in a side view."""
+def _forward(skeleton, positions, horizontal):
+    """The body's forward direction on the ground plane, and the axes.
+
+    Returns ``(forward, up, ground)``: ``forward`` a unit 2-D vector on the
+    ground axes ``ground`` (or one per frame, shape ``(n_frames, 2)``, for
+    ``horizontal="facing"``), ``up`` the index of the up axis.  Default: the
+    direction the root travels over the sequence, or the way the first frame
+    faces when it hardly travels.
+    """
     up = _AXES.index(skeleton.up_axis)
     ground = [a for a in range(3) if a != up]
+    if isinstance(horizontal, str):
+        if horizontal != "facing":
+            raise ValueError(
+                f"horizontal must be a direction or 'facing', got {horizontal!r}."
+            )
+        return _facings(skeleton, positions, up, ground), up, ground
     if horizontal is not None:
         direction = np.asarray(horizontal, dtype=np.float64)
         if direction.shape == (3,):
@@ -156,38 +172,101 @@ def _horizontal(skeleton, positions, horizontal):
     travel = positions[-1, 0, ground] - positions[0, 0, ground]
     if np.linalg.norm(travel) > 0.1 * _height(positions, up):
         return travel / np.linalg.norm(travel), up, ground
-    facing = _facing(skeleton, positions, up, ground)
-    return facing, up, ground
+    return _facing(skeleton, positions, up, ground), up, ground
 
 
-def _side_segments(skeleton, positions, horizontal):
-    """2-D segments (n_frames, n_bones - 1, 2, 2) of a side view, and the points."""
-    if isinstance(horizontal, str) and horizontal != "facing":
-        raise ValueError(
-            f"horizontal must be a direction or 'facing', got {horizontal!r}."
-        )
-    if isinstance(horizontal, str):
-        # every frame seen from its own side; figures placed along the path
-        up = _AXES.index(skeleton.up_axis)
-        ground = [a for a in range(3) if a != up]
-        facing = _facings(skeleton, positions, up, ground)
-        root = positions[:, :1, ground]
-        relative = np.einsum("fbg,fg->fb", positions[..., ground] - root, facing)
-        steps = np.einsum("fg,fg->f", np.diff(root[:, 0], axis=0), facing[:-1])
-        across = relative + np.concatenate([[0.0], np.cumsum(steps)])[:, None]
-    else:
-        direction, up, ground = _horizontal(skeleton, positions, horizontal)
-        across = positions[..., ground] @ direction
-    vertical = positions[..., up]
-    points = np.stack([across, vertical], axis=-1)
+# The cameras a drawing can take: the body's forward direction (f) and the
+# up axis (u) give each view's picture axes, (left to right, bottom to top).
+# "side" draws f left to right; "front" looks at the body from where it
+# faces, so its left hand (u x f) is on the right; "top" looks down, f left
+# to right as in the side view.  The indices are the body axes (f, u x f, u)
+# drawn left to right and bottom to top.
+VIEWS = ("auto", "front", "side", "top")
+_PICTURE_AXES = {"side": (0, 2), "front": (1, 2), "top": (0, 1)}
+# "auto" looks from above at motion whose joints spread up and down less than
+# this times as much as along either ground axis (on real takes, walks and
+# runs: 0.67 to 2.3; a turn: 0.08).
+TOP_SPREAD = 1 / 3
+
+
+def _check_view(view, allowed=VIEWS):
+    if not isinstance(view, str) or view not in allowed:
+        names = ", ".join(repr(name) for name in allowed)
+        raise ValueError(f"view must be one of {names}, got {view!r}.")
+    return view
+
+
+def _body_coordinates(positions, forward, up, ground):
+    """Joint positions along the body's axes (f, u x f, u): (n_frames, n_bones, 3).
+
+    With one ``forward`` per frame (a body that turns) each frame is seen
+    along its own axes, about its root, and placed along the path walked.
+    """
+    n_frames = len(positions)
+    f = np.zeros((n_frames, 3))
+    f[:, ground] = forward
+    u = np.zeros(3)
+    u[up] = 1.0
+    axes = np.stack([f, np.cross(u, f), np.broadcast_to(u, f.shape)], axis=1)
+    root = positions[:, :1]
+    relative = np.einsum("fbw,fcw->fbc", positions - root, axes)
+    steps = np.einsum("fw,fcw->fc", np.diff(root[:, 0], axis=0), axes[:-1])
+    path = root[0, 0] @ axes[0].T + np.concatenate([[np.zeros(3)], np.cumsum(steps, 0)])
+    return relative + path[:, None]
+
+
+def _auto_view(coordinates):
+    """The view facing the plane in which the joints move most.
+
+    ``coordinates``: a list of :func:`_body_coordinates`, one per sequence.
+    The joints' trajectories (each about its own mean over the frames,
+    travel included) are pooled.  On the ground plane, the side view when
+    they spread more along the forward direction than across it (a walk),
+    else the front view (a wave); the top view when they spread less than
+    ``TOP_SPREAD`` times as much up and down as along either ground axis
+    (a turn on flat ground).  Motion that hardly moves is seen from the
+    side.
+    """
+    spread = np.zeros(3)  # standard deviations along (f, u x f, u)
+    for coords in coordinates:
+        spread += ((coords - coords.mean(axis=0)) ** 2).mean(axis=(0, 1))
+    spread = np.sqrt(spread)
+    height = max(_height(coords, 2) for coords in coordinates)
+    if spread.max() <= 1e-6 * height:
+        return "side"
+    forward, across, up = spread
+    if up < TOP_SPREAD * min(forward, across):
+        return "top"
+    return "front" if across > forward else "side"
+
+
+def _view_segments(skeleton, coordinates, view):
+    """2-D segments (n_frames, n_bones - 1, 2, 2) of a view, and the points."""
+    points = coordinates[..., list(_PICTURE_AXES[view])]
     child, parent = _bone_pairs(skeleton)
     segments = np.stack([points[:, parent], points[:, child]], axis=2)
     return segments, points
 
 
-def _check_view(view):
-    if view not in ("side", "3d"):
-        raise ValueError(f"view must be 'side' or '3d', got {view!r}.")
+def _drawn(skeleton, data, feature_names, horizontal):
+    """The body drawn and its joints' coordinates along its axes."""
+    body, positions = _positions(skeleton, data, feature_names)
+    forward, up, ground = _forward(body, positions, horizontal)
+    return body, _body_coordinates(positions, forward, up, ground)
+
+
+def _chosen_view(view, horizontal, coordinates):
+    """``view``, with ``"auto"`` chosen from the motion (:func:`_auto_view`).
+
+    With a direction for ``horizontal``, ``"auto"`` is the side view, which
+    draws that direction left to right.
+    """
+    _check_view(view)
+    if view != "auto":
+        return view
+    if horizontal is not None and not isinstance(horizontal, str):
+        return "side"
+    return _auto_view(coordinates)
 
 
 def plot_skeleton(
@@ -218,13 +297,18 @@ def plot_skeleton(
         preprocessing's ``inverse_transform``.
     feature_names : array-like of str, default=None
         Name of each channel; default ``skeleton.feature_names``.
-    view : {"side", "3d"}, default="side"
+    view : {"side", "front", "top", "3d"}, default="side"
         ``"side"``: an orthographic side view on the vertical plane through
-        ``horizontal``.  ``"3d"``: matplotlib 3-D axes, up axis vertical.
+        ``horizontal``; ``"front"``: seen from where the body faces (its
+        left hand on the right); ``"top"``: seen from above, ``horizontal``
+        left to right.  ``"3d"``: matplotlib 3-D axes, up axis vertical.
+        (One frame has no motion to choose a view from: the functions that
+        draw motion also take ``"auto"``.)
     horizontal : array-like of shape (3,) or (2,) or "facing", default=None
-        World (or ground-plane) direction drawn left to right in the side
-        view; default (and ``"facing"``) the direction the body faces
-        (perpendicular to the hips).
+        The body's forward direction, in world (or ground-plane)
+        coordinates: drawn left to right in the side and top views, looked
+        along in the front view; default (and ``"facing"``) the direction
+        the body faces (perpendicular to the hips).
     ax : matplotlib Axes, default=None
         Where to draw (3-D axes for ``view="3d"``); default a new figure.
     color : color, default="k"
@@ -249,7 +333,7 @@ def plot_skeleton(
     17
     """
     check_matplotlib()
-    _check_view(view)
+    _check_view(view, ("front", "side", "top", "3d"))
     body, positions = _positions(skeleton, frame, feature_names)
     positions = positions[:1]
     if view == "3d":
@@ -281,7 +365,9 @@ def plot_skeleton(
     from matplotlib.collections import LineCollection
 
     ax = get_axes(ax)
-    segments, points = _side_segments(body, positions, horizontal)
+    forward, up, ground = _forward(body, positions, horizontal)
+    coordinates = _body_coordinates(positions, forward, up, ground)
+    segments, points = _view_segments(body, coordinates, view)
     ax.add_collection(LineCollection(segments[0], colors=color, linewidths=linewidth))
     _frame_limits(ax, points.reshape(-1, 2))
     return ax
@@ -302,6 +388,7 @@ def plot_motion_strip(
     feature_names=None,
     step=4,
     spacing="auto",
+    view="auto",
     horizontal=None,
     ax=None,
     color="k",
@@ -311,9 +398,10 @@ def plot_motion_strip(
 ):
     """Draw every ``step``-th frame side by side, like Fig. 3 of the paper.
 
-    Each drawn frame is a stick figure at its place in the world, seen from
-    the side with the up axis vertical, so a walk moves from left to right;
-    ``spacing`` adds room between figures that would otherwise overlap.
+    Each drawn frame is a stick figure at its place in the world, seen
+    from the side that shows the motion best (a walk from the side, moving
+    from left to right; a wave from the front); ``spacing`` adds room
+    between figures that would otherwise overlap.
 
     Parameters
     ----------
@@ -331,13 +419,23 @@ def plot_motion_strip(
         Extra distance added between consecutive figures along the
         horizontal axis.  ``"auto"`` spreads them by at least 0.4 body
         heights each (a walk advances far less than a body width in 4
-        frames); ``0`` draws them where they are.
+        frames), and in the front and top views by at least the widest
+        figure; ``0`` draws them where they are.
+    view : {"auto", "front", "side", "top"}, default="auto"
+        Where the camera is, relative to the body's forward direction
+        (``horizontal``): ``"side"`` draws the forward direction left to
+        right, ``"front"`` looks at the body from where it faces (its left
+        hand on the right), ``"top"`` looks down, forward left to right.
+        ``"auto"`` faces the plane in which the joints move most (the
+        side of a walk, the front of a wave, the top of a turn); with a
+        direction given as ``horizontal``, the side view.
     horizontal : array-like of shape (3,) or (2,) or "facing", default=None
-        World (or ground-plane) direction drawn left to right; default the
-        direction the root travels over the sequence (the way the body faces
-        when it hardly travels).  ``"facing"`` draws every frame from its
-        own side (perpendicular to its hips) and places the figures along
-        the path walked, for motion that turns.
+        The body's forward direction, in world (or ground-plane)
+        coordinates; default the direction the root travels over the
+        sequence (the way the body faces when it hardly travels).
+        ``"facing"`` sees every frame along its own forward direction
+        (perpendicular to its hips) and places the figures along the path
+        walked, for motion that turns.
     ax : matplotlib Axes, default=None
         Where to draw; default a new wide figure.
     color : color or list of colors, default="k"
@@ -345,7 +443,7 @@ def plot_motion_strip(
     linewidth : float, default=1.5
         Line width.
     ground : bool, default=True
-        Draw a thin ground line under the figures.
+        Draw a thin ground line under the figures (not in the top view).
     max_figures : int or None, default=30
         At most this many figures, so that they stay readable: when ``step``
         would draw more, the step grows to ``ceil(n_frames / max_figures)``
@@ -388,19 +486,21 @@ def plot_motion_strip(
         )
     ):
         raise ValueError(f"spacing must be 'auto' or a number >= 0, got {spacing!r}.")
-    body, positions = _positions(skeleton, data, feature_names)
-    segments, points = _side_segments(body, positions, horizontal)
+    body, coordinates = _drawn(skeleton, data, feature_names, horizontal)
+    view = _chosen_view(view, horizontal, [coordinates])
+    segments, points = _view_segments(body, coordinates, view)
     if max_figures is not None:
-        step = max(step, -(-len(positions) // max_figures))
-    drawn = np.arange(0, len(positions), step)
+        step = max(step, -(-len(coordinates) // max_figures))
+    drawn = np.arange(0, len(coordinates), step)
     segments, points = segments[drawn], points[drawn]
     if spacing == "auto":
-        up = _AXES.index(body.up_axis)
-        height = _height(positions, up)
+        room = 0.4 * _height(coordinates, 2)
+        if view != "side":  # figures as wide as they are: arms spread, steps
+            room = max(room, 1.05 * np.ptp(points[..., 0], axis=1).max())
         advance = 0.0
         if len(drawn) > 1:
             advance = (points[-1, 0, 0] - points[0, 0, 0]) / (len(drawn) - 1)
-        spacing = max(0.0, 0.4 * height - advance)
+        spacing = max(0.0, room - advance)
     shift = np.zeros(2)
     if ax is None:
         plt = check_matplotlib()
@@ -417,7 +517,7 @@ def plot_motion_strip(
         )
     flat = points.reshape(-1, 2)
     _frame_limits(ax, flat, margin=0.05)
-    if ground:
+    if ground and view != "top":
         ax.axhline(flat[:, 1].min(), color="0.6", linewidth=0.8, zorder=0)
     ax.set_xticks([])
     ax.set_yticks([])
@@ -431,13 +531,14 @@ def animate_motion(
     feature_names=None,
     frame_rate=30.0,
     follow=True,
+    view="auto",
     horizontal=None,
     ax=None,
     color="k",
     linewidth=2.0,
     title=None,
 ):
-    """Animate a sequence as a moving stick figure (side view, up axis vertical).
+    """Animate a sequence as a moving stick figure.
 
     Save it with :func:`save_animation` (GIF through Pillow, MP4 through
     ffmpeg) or show it in a notebook with :func:`motion_to_html`.
@@ -455,10 +556,13 @@ def animate_motion(
     follow : bool, default=True
         Keep the figure centred by moving the view with the root; otherwise
         the view covers the whole path.
+    view : {"auto", "front", "side", "top"}, default="auto"
+        Where the camera is; ``"auto"`` faces the plane in which the joints
+        move most (see :func:`plot_motion_strip`).
     horizontal : array-like of shape (3,) or (2,) or "facing", default=None
-        World (or ground-plane) direction drawn left to right; default the
-        direction the root travels; ``"facing"`` follows the body as it
-        turns (see :func:`plot_motion_strip`).
+        The body's forward direction; default the direction the root
+        travels; ``"facing"`` follows the body as it turns (see
+        :func:`plot_motion_strip`).
     ax : matplotlib Axes, default=None
         Where to draw; default a new figure.
     color : color, default="k"
@@ -489,9 +593,11 @@ def animate_motion(
     from matplotlib.animation import FuncAnimation
 
     frame_rate = _check_frame_rate(frame_rate)
+    body, coordinates = _drawn(skeleton, data, feature_names, horizontal)
+    view = _chosen_view(view, horizontal, [coordinates])
     ax = get_axes(ax)
     update, n_frames = _motion_updater(
-        ax, skeleton, data, feature_names, follow, horizontal, color, linewidth, title
+        ax, (body, coordinates, view), follow, color, linewidth, title
     )
     update(0)
     return FuncAnimation(
@@ -511,44 +617,54 @@ def _check_frame_rate(frame_rate):
     return float(frame_rate)
 
 
-def _motion_updater(
-    ax, skeleton, data, feature_names, follow, horizontal, color, linewidth, title
-):
+def _motion_updater(ax, drawn, follow, color, linewidth, title):
     """Draw frame 0 of a sequence on ``ax``; ``(update(k), n_frames)``.
 
+    ``drawn`` is :func:`_drawn`'s ``(body, coordinates, view)``;
     ``update(k)`` draws frame ``k`` (the last frame for ``k`` beyond it).
+    Following, the side and front views move left and right with the
+    root, over a fixed ground; the top view moves both ways.
     """
     from matplotlib.collections import LineCollection
 
-    body, positions = _positions(skeleton, data, feature_names)
-    segments, points = _side_segments(body, positions, horizontal)
-    up = _AXES.index(body.up_axis)
-    height = _height(positions, up)
+    body, coordinates, view = drawn
+    segments, points = _view_segments(body, coordinates, view)
+    height = _height(coordinates, 2)
     lines = LineCollection(segments[0], colors=color, linewidths=linewidth)
     ax.add_collection(lines)
     low = points[..., 1].min() - 0.05 * height
     high = points[..., 1].max() + 0.05 * height
-    ax.set_ylim(low, high)
-    ax.axhline(points[..., 1].min(), color="0.6", linewidth=0.8, zorder=0)
-    half = 0.75 * (high - low)
+    widest = np.ptp(points, axis=1).max(axis=0)  # of one frame, on each axis
+    if view == "top":
+        half = 0.55 * widest.max() + 0.05 * height
+    else:
+        ax.set_ylim(low, high)
+        ax.axhline(points[..., 1].min(), color="0.6", linewidth=0.8, zorder=0)
+        half = max(0.75 * (high - low), 0.55 * widest[0] + 0.05 * height)
     if not follow:
         _frame_limits(ax, points.reshape(-1, 2), margin=0.05)
-    else:
-        ax.set_xlim(points[0, 0, 0] - half, points[0, 0, 0] + half)
-        ax.set_aspect("equal")
+    ax.set_aspect("equal")
     ax.set_xticks([])
     ax.set_yticks([])
+
+    def centre(k):
+        ax.set_xlim(points[k, 0, 0] - half, points[k, 0, 0] + half)
+        if view == "top":
+            ax.set_ylim(points[k, 0, 1] - half, points[k, 0, 1] + half)
+
+    if follow:
+        centre(0)
 
     def update(k):
         k = min(k, len(segments) - 1)
         lines.set_segments(segments[k])
         if follow:
-            ax.set_xlim(points[k, 0, 0] - half, points[k, 0, 0] + half)
+            centre(k)
         if title is not None:
             ax.set_title(f"{title}  frame {k}")
         return (lines,)
 
-    return update, len(positions)
+    return update, len(points)
 
 
 def animate_motions(
@@ -562,6 +678,7 @@ def animate_motions(
     proba=None,
     classes=None,
     follow=True,
+    view="auto",
     horizontal=None,
     panel_width=2.6,
     figure=None,
@@ -569,9 +686,9 @@ def animate_motions(
     """Animate several sequences side by side, frame by frame together.
 
     Real motion beside generated motion, or one generated sequence per
-    style: each sequence gets its own panel (side view, up axis vertical),
-    and every panel shows the same frame.  With ``proba``, a panel below
-    plots the probability of each style over the frames (see
+    style: each sequence gets its own panel, all seen from the same side
+    (up axis vertical), and every panel shows the same frame.  With
+    ``proba``, a panel below plots the probability of each style over the frames (see
     :func:`~sklearn_crbm.plotting.plot_style_probabilities`) with a line at
     the frame shown.  Save it with :func:`save_animation`, at
     ``frame_rate / step`` frames per second to play in real time.
@@ -597,6 +714,10 @@ def animate_motions(
         The names of the styles of ``proba``.
     follow : bool, default=True
         Move each panel's view with its root (see :func:`animate_motion`).
+    view : {"auto", "front", "side", "top"}, default="auto"
+        Where the camera is (see :func:`plot_motion_strip`), the same for
+        every panel; ``"auto"`` faces the plane in which the joints of all
+        the sequences together move most.
     horizontal : array-like of shape (3,) or (2,) or "facing", default=None
         As for :func:`animate_motion`.
     panel_width : float, default=2.6
@@ -642,14 +763,16 @@ def animate_motions(
         figure = plt.figure(
             figsize=(max(panel_width * len(sequences), 5.0), 3.0 + 2.0 * (rows - 1))
         )
+    drawn = [_drawn(skeleton, data, feature_names, horizontal) for data in sequences]
+    view = _chosen_view(view, horizontal, [coordinates for _, coordinates in drawn])
     grid = figure.add_gridspec(rows, len(sequences), height_ratios=[3, 2][:rows])
     updates, n_frames = [], 0
-    for k, (data, title) in enumerate(zip(sequences, titles, strict=True)):
+    for k, ((body, coordinates), title) in enumerate(zip(drawn, titles, strict=True)):
         ax = figure.add_subplot(grid[0, k])
         if title is not None:
             ax.set_title(title, fontsize=9)
         update, length = _motion_updater(
-            ax, skeleton, data, feature_names, follow, horizontal, "k", 2.0, None
+            ax, (body, coordinates, view), follow, "k", 2.0, None
         )
         updates.append(update)
         n_frames = max(n_frames, length)
@@ -693,7 +816,10 @@ def save_animation(animation, filename, *, frame_rate=30.0, dpi=80):
         ``FFMpegWriter`` (needs the ``ffmpeg`` program); ``.html`` writes the
         self-contained JavaScript player of :func:`motion_to_html`.
     frame_rate : float, default=30.0
-        Frames per second.
+        Frames per second.  A GIF stores each frame's delay in whole
+        hundredths of a second: the delays alternate (70, 70 and 60 ms at
+        15 frames per second) so that every stretch of the GIF plays in
+        its time to within a hundredth of a second.
     dpi : int, default=80
         Resolution of the frames.
 
@@ -722,7 +848,7 @@ def save_animation(animation, filename, *, frame_rate=30.0, dpi=80):
     path = Path(filename)
     suffix = path.suffix.lower()
     if suffix == ".gif":
-        writer = mpl_animation.PillowWriter(fps=frame_rate)
+        writer = _timed_gif_writer(mpl_animation.PillowWriter)(fps=frame_rate)
     elif suffix == ".mp4":
         if not mpl_animation.FFMpegWriter.isAvailable():
             raise RuntimeError(
@@ -740,6 +866,38 @@ def save_animation(animation, filename, *, frame_rate=30.0, dpi=80):
         )
     animation.save(path, writer=writer, dpi=dpi)
     return path
+
+
+def _gif_delays(n_frames, frame_rate):
+    """Each frame's delay in a GIF, in hundredths of a second.
+
+    Frame ``k`` starts at ``round(100 * k / frame_rate)`` hundredths, so the
+    first ``k`` frames last ``k / frame_rate`` seconds to within half a
+    hundredth, however many frames there are.
+    """
+    starts = np.rint(100.0 * np.arange(n_frames + 1) / frame_rate)
+    return np.diff(starts).astype(int)
+
+
+def _timed_gif_writer(pillow_writer):
+    """matplotlib's ``PillowWriter``, writing the delays of :func:`_gif_delays`.
+
+    (``PillowWriter`` gives every frame ``int(1000 / fps)`` ms, which a GIF
+    stores as whole hundredths: 66.7 ms becomes 60, 11% fast.)
+    """
+
+    class TimedPillowWriter(pillow_writer):
+        def finish(self):
+            delays = _gif_delays(len(self._frames), self.fps)
+            self._frames[0].save(
+                self.outfile,
+                save_all=True,
+                append_images=self._frames[1:],
+                duration=[10 * int(delay) for delay in delays],
+                loop=0,
+            )
+
+    return TimedPillowWriter
 
 
 def motion_to_html(skeleton, data, *, feature_names=None, frame_rate=30.0, **kwargs):

@@ -11,10 +11,12 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from numpy.testing import assert_allclose  # noqa: E402
+from PIL import Image  # noqa: E402
 
 from sklearn_crbm.datasets import make_walker  # noqa: E402
 from sklearn_crbm.plotting import (  # noqa: E402
     animate_motion,
+    animate_motions,
     motion_to_html,
     plot_filled_channels,
     plot_hidden_activations,
@@ -65,7 +67,7 @@ def test_plot_skeleton_3d_and_horizontal(walker):
     across = np.array([seg[1, 0] for seg in side.collections[0].get_segments()])
     assert_allclose(across, positions[1:, 2])  # z drawn left to right
     with pytest.raises(ValueError, match="view"):
-        plot_skeleton(walker.skeleton, walker.data[0], view="top")
+        plot_skeleton(walker.skeleton, walker.data[0], view="bottom")
     with pytest.raises(ValueError, match="horizontal"):
         plot_skeleton(walker.skeleton, walker.data[0], horizontal=(0, 1, 0))
 
@@ -242,3 +244,107 @@ def test_a_static_dummy_root_is_not_drawn(data_home):
     assert np.ptp(segments[..., 0]) < 100.0 and 100.0 < np.ptp(segments[..., 1]) < 200.0
     strip = plot_motion_strip(skeleton, data[:120], step=8)
     assert len(strip.collections) >= 15
+
+
+# -- views: the camera chosen from the motion --------------------------------
+
+
+def _bandai_take(data_home, name):
+    from sklearn_crbm.datasets import read_bvh
+
+    path = data_home / "bandai_contents" / f"dataset-2_{name}_normal_001.bvh"
+    skeleton, data, _, _ = read_bvh(path)
+    return skeleton, data
+
+
+def _joint_track(ax, skeleton, bone):
+    """Where ``bone`` is drawn in each figure of a strip (its body lacks the
+    static joint_Root: segment ``i`` ends at bone ``i + 2``)."""
+    index = skeleton.bone_names.index(bone) - 2
+    return np.array([c.get_segments()[index][1] for c in ax.collections])
+
+
+def test_auto_view_faces_the_plane_the_motion_moves_in(data_home, walker):
+    """A lateral hand wave is seen from the front, a walk from the side, a
+    turn from above; ``view=`` names the camera."""
+    skeleton, wave = _bandai_take(data_home, "wave-left-hand")
+    every = dict(step=1, max_figures=None, spacing=0, ground=False)
+    drawn = {
+        view: plot_motion_strip(skeleton, wave, view=view, **every)
+        for view in ("auto", "front", "side")
+    }
+    tracks = {view: _joint_track(ax, skeleton, "Hand_L") for view, ax in drawn.items()}
+    assert_allclose(tracks["auto"], tracks["front"])
+    # seen from the front, the waving hand sweeps across twice as far ...
+    assert np.ptp(tracks["front"][:, 0]) > 1.8 * np.ptp(tracks["side"][:, 0])
+    # ... and the left hand is on the right, as seen facing the body
+    right = _joint_track(drawn["front"], skeleton, "Hand_R")
+    assert np.all(tracks["front"][:, 0] > right[:, 0])
+    for view, take in (("side", walker.data), ("top", None)):
+        if take is None:
+            skeleton, take = _bandai_take(data_home, "walk-turn-left")
+        else:
+            skeleton = walker.skeleton
+        auto = plot_motion_strip(skeleton, take, step=8, spacing=0)
+        chosen = plot_motion_strip(skeleton, take, step=8, spacing=0, view=view)
+        for a, b in zip(auto.collections, chosen.collections, strict=True):
+            assert_allclose(a.get_segments(), b.get_segments())
+    assert len(chosen.get_lines()) == 0  # no ground line seen from above
+    with pytest.raises(ValueError, match="view must be one of 'auto', 'front'"):
+        plot_motion_strip(walker.skeleton, walker.data, view="back")
+
+
+def test_top_view_draws_the_ground_plane(walker):
+    data = walker.data[:1]
+    ax = plot_skeleton(walker.skeleton, data, view="top", horizontal=(1, 0, 0))
+    positions = walker.skeleton.forward_kinematics(data)[0]
+    ends = np.array([seg[1] for seg in ax.collections[0].get_segments()])
+    # forward +x with y up: x left to right, the body's left (u x f = y x x
+    # = -z) bottom to top
+    assert_allclose(ends[:, 0], positions[1:, 0])
+    assert_allclose(ends[:, 1], -positions[1:, 2])
+
+
+def test_horizontal_direction_keeps_the_side_view(walker):
+    ax = plot_motion_strip(walker.skeleton, walker.data, horizontal=(0, 0, 1))
+    side = plot_motion_strip(
+        walker.skeleton, walker.data, horizontal=(0, 0, 1), view="side"
+    )
+    for a, b in zip(ax.collections, side.collections, strict=True):
+        assert_allclose(a.get_segments(), b.get_segments())
+
+
+def test_animate_motions_sees_every_panel_from_one_side(data_home, tmp_path):
+    skeleton, wave = _bandai_take(data_home, "wave-left-hand")
+    still = np.repeat(wave[:1], 40, axis=0)  # a figure that came to rest
+    animation = animate_motions(skeleton, [wave[:40], still], view="auto")
+    panels = animation._fig.axes[:2]
+    save_animation(animation, tmp_path / "two.gif", dpi=10)
+    animation._func(0)
+    front = plot_skeleton(skeleton, wave[0], view="front")
+    for panel in panels:
+        assert_allclose(
+            panel.collections[0].get_segments(), front.collections[0].get_segments()
+        )
+
+
+@pytest.mark.parametrize("frame_rate", [15.0, 30.0, 24.0, 12.5])
+def test_gif_lasts_its_frames_over_the_frame_rate(walker, tmp_path, frame_rate):
+    """GIF delays are whole hundredths: they alternate so that every stretch
+    of frames lasts its time (at 15 frames/s: 70, 70, 60 ms in some order)."""
+    n = 12
+    animation = animate_motion(walker.skeleton, walker.data[:n], title="walk")
+    path = save_animation(
+        animation, tmp_path / "walk.gif", frame_rate=frame_rate, dpi=20
+    )
+    gif = Image.open(path)
+    delays = []
+    for k in range(gif.n_frames):
+        gif.seek(k)
+        delays.append(gif.info["duration"])
+    assert len(delays) == n
+    elapsed = np.cumsum(delays) / 1000.0
+    ideal = np.arange(1, n + 1) / frame_rate
+    assert np.abs(elapsed - ideal).max() <= 0.005 + 1e-9
+    if frame_rate == 15.0:
+        assert sorted(delays[:3]) == [60, 70, 70]
