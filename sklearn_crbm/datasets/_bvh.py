@@ -4,13 +4,8 @@ import numpy as np
 
 from ..utils._rotations import matrix_to_euler
 from ._bone import Bone
-from ._bvh_hierarchy import (
-    CHANNEL_TO_BVH,
-    END_SITE_SUFFIX,
-    parse_bvh_hierarchy,
-    split_header,
-)
-from ._channels import EULER_CHANNELS, TRANSLATION_CHANNELS
+from ._bvh_hierarchy import CHANNEL_TO_BVH, parse_bvh_hierarchy, split_header
+from ._channels import END_SITE_SUFFIX, EULER_CHANNELS, TRANSLATION_CHANNELS
 from ._frame_rate import check_rate
 from ._parsing import check_bone_names, format_number, parse_error, parse_floats
 from ._skeleton import Skeleton
