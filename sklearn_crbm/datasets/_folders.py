@@ -35,7 +35,9 @@ def read_bvh_folder(
     Bandai Namco file the ground joint ``joint_Root`` travels while its
     ``Hips`` stay) is rewritten: the joints above are set as still as in the
     other files and the travel moved into that joint, every joint below it
-    in the same place, with a warning that names the file.
+    in the same place, with a warning that names the file.  When as many
+    files travel with one joint as with another, the lower joint is taken:
+    the result never depends on the order of the files.
 
     Parameters
     ----------
@@ -46,8 +48,9 @@ def read_bvh_folder(
         ``"**/*.bvh"`` also reads sub-folders.
     frame_rate : float, default=None
         Frame rate of the returned data.  Files recorded faster are brought
-        down to it by dropping frames (see :func:`resample_frames`).
-        ``None`` keeps the files' rate, which must then be the same for all.
+        down to it by dropping frames (see :func:`resample_frames`), with a
+        warning that names them when the files' rates differ.  ``None``
+        keeps the files' rate, which must then be the same for all.
     labels : str, re.Pattern or callable, default=None
         Where each file's label comes from:
 
@@ -119,7 +122,8 @@ def read_bvh_folder(
     Warns
     -----
     UserWarning
-        When a file's travel is moved into another joint (see above).
+        When a file's travel is moved into another joint (see above), or
+        ``frame_rate`` drops frames of files whose rates differ.
 
     Examples
     --------
@@ -282,8 +286,8 @@ def _long_format(folder, sequences, frame_rate, kind):
     """The Bunch of :func:`read_bvh_folder` from ``(path, skeleton, data, rate)``."""
     sequences = check_agreement(sequences, frame_rate)
     first_skeleton = sequences[0][1]
-    if frame_rate is None:
-        frame_rate = sequences[0][3]
+    if frame_rate is None:  # the files' rates agree to RATIO_TOLERANCE
+        frame_rate = min(rate for _, _, _, rate in sequences)
         kept = [data for _, _, data, _ in sequences]
     else:
         frame_rate = check_rate(frame_rate, "frame_rate")
