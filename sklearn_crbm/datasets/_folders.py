@@ -71,7 +71,10 @@ def read_bvh_folder(
         must be among them.  ``None``: for a JSON key, the file
         ``{key}_label.txt`` in ``folder`` or in ``folder/../cfg`` when there
         is one (the Bandai Namco repository's ``style_label.txt``), else the
-        distinct labels in sorted order.  Without label names the labels must
+        distinct labels in sorted order (numbers in numeric order).  Names
+        read from a file lose a prefix that all of them share up to an
+        underscore: the Bandai Namco ``dataset-2_walk``, ``dataset-2_run``...
+        are ``walk``, ``run``...  Without label names the labels must
         be of one kind (all names, all integers, all booleans or all
         floats): ``true``, ``1`` and ``1.0`` are one value to Python and
         would merge into one class, so a mix is refused.  NaN is never a
@@ -87,8 +90,10 @@ def read_bvh_folder(
         target : ndarray of shape (n_frames,)
             Only with ``labels``: the code of every frame's label, an index
             into ``target_names``.
-        target_names : ndarray
-            Only with ``labels``: the label names.
+        target_names : ndarray of str
+            Only with ``labels``: the label names, as text (labels that are
+            numbers too), ready to use as class labels:
+            ``target_names[target]`` is the label of every frame.
         sequence_names : ndarray of str
             One name per file, e.g. ``"walk_01"`` or ``"subject1/walk_01"``.
         feature_names : ndarray of str
