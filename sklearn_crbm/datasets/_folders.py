@@ -116,10 +116,13 @@ def read_bvh_folder(
         a JSON label file is missing.
     ValueError
         If a file is malformed, the files' skeletons or up axes differ,
-        their frame rates differ and ``frame_rate`` is None, a file's travel
+        their frame rates differ and ``frame_rate`` is None (the message
+        says what ``frame_rate=`` the slowest rate does to each file), a
+        file is slower than ``frame_rate``, a file is empty, a file's travel
         cannot be moved into the joint most files travel with, a file's
-        label is missing, not a finite value or not among ``label_names``.
-        The message names the file.
+        label is missing, not a finite value or not among ``label_names``
+        (a str ``labels`` is a JSON key; a label from the file names needs
+        a compiled pattern).  The message names the file.
     TypeError
         If a label is not a single name or number, or the labels mix kinds
         (``true``, ``1`` and ``1.0`` would merge into one class).
