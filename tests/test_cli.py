@@ -784,3 +784,20 @@ def test_every_drawing_command_takes_a_view(walker_model, tmp_path, monkeypatch)
     argv = ["sample", str(walker_model[0]), "--n-frames", "4", "--animate"]
     assert main([*argv, "--output", str(tmp_path), "--view", "top"]) == 0
     assert seen == ["top"]
+
+
+def test_fit_on_files_of_different_rates_says_what_frame_rate_does(tmp_path, capsys):
+    folder = _walker_folder(tmp_path / "mine", 30.0, n_frames=30)
+    walker = make_walker(n_sequences=1, n_frames=60, random_state=0)
+    write_bvh(folder / "walk_fast_003.bvh", walker.data, walker.skeleton, 60.0)
+    (folder / "walk_fast_003.json").write_text('{"style": 1}')
+    model = str(tmp_path / "m.joblib")
+    assert main(["fit", str(folder), *TINY, "--output", model]) == 1
+    err = capsys.readouterr().err
+    assert "walk_fast_003.bvh has 60 frames per second, but the other 4 files" in err
+    assert "--frame-rate 30 brings every file to 30 frames per second" in err
+    assert "every 2nd frame of walk_fast_003.bvh" in err
+    assert "leave it out" not in err
+    argv = ["fit", str(folder), *TINY, "--frame-rate", "30", "--output", model]
+    with pytest.warns(UserWarning, match="every 2nd frame of walk_fast_003.bvh"):
+        assert main(argv) == 0

@@ -252,11 +252,12 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
     except ValueError as exc:
         if "by dropping frames" not in str(exc):  # not about the frame rates
             raise
-        given = "" if frame_rate is None else f"--frame-rate {frame_rate:g}: "
+        if frame_rate is None:  # the files disagree: say the option to pass
+            raise ValueError(str(exc).replace("frame_rate=", "--frame-rate ")) from None
         raise ValueError(
-            f"{given}{exc} On the command line, --frame-rate sets the rate to "
-            "train at: at most the slowest file's (leave it out to train at the "
-            "files' own rate)."
+            f"--frame-rate {frame_rate:g}: {exc} On the command line, --frame-rate "
+            "sets the rate to train at: at most the slowest file's (leave it out to "
+            "train at the files' own rate)."
         ) from None
     if frame_rate is None and data.frame_rate > MAX_DEFAULT_RATE:
         keep = resample_frames(

@@ -322,9 +322,6 @@ def load_bandai_walks(data_home=None):
     walks = read_bvh_folder(
         names.parent, pattern="*_walk_*.bvh", frame_rate=FRAME_RATE, labels="style"
     )
-    walks.target_names = np.array(
-        [name.removeprefix("dataset-2_") for name in walks.target_names], dtype=object
-    )
     walks.takes = np.array([int(name[-3:]) for name in walks.sequence_names])
     walks.DESCR = BANDAI_DESCR
     return walks

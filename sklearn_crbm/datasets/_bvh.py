@@ -4,14 +4,9 @@ import numpy as np
 
 from ..utils._rotations import matrix_to_euler
 from ._bone import Bone
-from ._bvh_hierarchy import (
-    CHANNEL_TO_BVH,
-    END_SITE_SUFFIX,
-    parse_bvh_hierarchy,
-    split_header,
-)
-from ._channels import EULER_CHANNELS, TRANSLATION_CHANNELS
-from ._frame_rate import check_rate
+from ._bvh_hierarchy import CHANNEL_TO_BVH, parse_bvh_hierarchy, split_header
+from ._channels import END_SITE_SUFFIX, EULER_CHANNELS, TRANSLATION_CHANNELS
+from ._frame_rate import check_rate, rate_of_frame_time
 from ._parsing import check_bone_names, format_number, parse_error, parse_floats
 from ._skeleton import Skeleton
 from ._up_axis import UP_AXIS_COMMENT, declared_up_axis, settle_up_axis
@@ -45,7 +40,11 @@ def read_bvh(path):
         ``tx``, ``ty``, ``tz`` (``Xposition`` ...) and ``rx``, ``ry``, ``rz``
         (``Xrotation`` ...), in file order.
     frame_rate : float
-        ``1 / Frame Time``.
+        ``1 / Frame Time``, taken as a whole number of frames per second
+        when the ``Frame Time`` written is that number's, rounded to the
+        digits written: 60.0 for ``0.0166667``, not 59.9999 (see
+        :func:`resample_frames` for the same tolerance).  Other rates are
+        ``1 / Frame Time`` exactly (29.97 for ``0.0333667``).
 
     Raises
     ------
@@ -63,37 +62,38 @@ def read_bvh(path):
     >>> path = os.path.join(tempfile.mkdtemp(), "walk.bvh")
     >>> write_bvh(path, walker.data, walker.skeleton, walker.frame_rate)
     >>> skeleton, data, names, frame_rate = read_bvh(path)
-    >>> data.shape, round(frame_rate, 6)  # three rotation channels per joint
+    >>> data.shape, frame_rate  # three rotation channels per joint
     ((3, 57), 30.0)
     """
     header, motion = split_header(path)
     skeleton = Skeleton(**parse_bvh_hierarchy(path, header))
     n_channels = len(skeleton.feature_names)
-    n_frames, frame_time, rows = _parse_motion_header(path, motion)
+    n_frames, frame_rate, rows = _parse_motion_header(path, motion)
     data = _parse_rows(path, rows, n_channels, n_frames, motion[-1][0])
     settle_up_axis(skeleton, path, declared_up_axis(header), data)
-    return skeleton, data, skeleton.feature_names, 1.0 / frame_time
+    return skeleton, data, skeleton.feature_names, frame_rate
 
 
 def _parse_motion_header(path, motion):
-    """``(n_frames, frame_time, data lines)`` from the lines after MOTION."""
+    """``(n_frames, frame_rate, data lines)`` from the lines after MOTION."""
     lines = [(n, t.strip()) for n, t in motion[1:] if t.strip()]
     end_line = motion[-1][0]
-    n_frames = _labelled_number(path, lines, 0, "Frames:", end_line)
+    n_frames, _ = _labelled_number(path, lines, 0, "Frames:", end_line)
     if n_frames < 0 or not n_frames.is_integer():
         raise parse_error(
             path, lines[0][0], f"expected a whole number of frames, got {n_frames!r}"
         )
-    frame_time = _labelled_number(path, lines, 1, "Frame Time:", end_line)
+    frame_time, written = _labelled_number(path, lines, 1, "Frame Time:", end_line)
     if not (frame_time > 0 and np.isfinite(1.0 / frame_time)):
         raise parse_error(
             path, lines[1][0], f"expected a positive frame time, got {frame_time!r}"
         )
-    return int(n_frames), frame_time, lines[2:]
+    return int(n_frames), rate_of_frame_time(frame_time, written), lines[2:]
 
 
 def _labelled_number(path, lines, k, label, end_line):
-    """The number on line ``k`` of ``lines``, which must read ``label number``."""
+    """``(number, its text)`` on line ``k`` of ``lines``, which must read
+    ``label number``."""
     if k >= len(lines) or not lines[k][1].startswith(label):
         lineno = lines[k][0] if k < len(lines) else end_line
         raise parse_error(path, lineno, f"expected '{label} ...' after MOTION")
@@ -101,7 +101,7 @@ def _labelled_number(path, lines, k, label, end_line):
     tokens = text[len(label) :].split()
     if len(tokens) != 1:
         raise parse_error(path, lineno, f"expected one number after {label!r}")
-    return parse_floats(tokens, path, lineno, label)[0]
+    return parse_floats(tokens, path, lineno, label)[0], tokens[0]
 
 
 def _parse_rows(path, rows, n_channels, n_frames, last_line):

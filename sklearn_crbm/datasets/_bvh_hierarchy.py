@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ._bone import Bone
-from ._channels import EULER_CHANNELS
+from ._channels import END_SITE_SUFFIX, EULER_CHANNELS
 from ._parsing import parse_error, parse_floats, read_lines
 from ._up_axis import without_up_axis_comment
 
@@ -22,7 +22,6 @@ _BVH_TO_CHANNEL = {
     for kind, short in (("position", "t"), ("rotation", "r"))
 }
 CHANNEL_TO_BVH = {v: k for k, v in _BVH_TO_CHANNEL.items()}
-END_SITE_SUFFIX = "_end"
 OTHER_FORMAT_HINTS = {
     ".amc": "; this is an Acclaim AMC file: read it with read_amc(path, skeleton), "
     "the skeleton from Skeleton.from_asf(its ASF file)",

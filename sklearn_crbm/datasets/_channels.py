@@ -8,6 +8,7 @@ module's file format.
 import numpy as np
 
 __all__ = [
+    "END_SITE_SUFFIX",
     "EULER_CHANNELS",
     "EXPMAP_CHANNELS",
     "KNOWN_CHANNELS",
@@ -22,6 +23,8 @@ EULER_CHANNELS = ("rx", "ry", "rz")
 EXPMAP_CHANNELS = ("ex", "ey", "ez")
 TRANSLATION_CHANNELS = ("tx", "ty", "tz")
 OFFSET_CHANNELS = ("ox", "oy", "oz")
+# A BVH end site is a bone without channels named after its parent.
+END_SITE_SUFFIX = "_end"
 KNOWN_CHANNELS = (
     EULER_CHANNELS + EXPMAP_CHANNELS + TRANSLATION_CHANNELS + OFFSET_CHANNELS
 )
@@ -40,11 +43,14 @@ def bone_columns(feature_names, bones, *, strict=True):
     feature_names : array-like of str
         Column names.
     bones : str or iterable of str
-        Bone names.
+        Bone names.  An end site (a BVH joint without channels, named
+        ``"{parent}_end"``) listed with its parent needs no column, so the
+        bones of :meth:`Skeleton.descendants` can be passed as they are.
     strict : bool, default=True
-        If True, every bone must have a column.  If False, bones without a
-        column are skipped (a preprocessor drops constant channels, such as
-        the clavicles of CMU data), but at least one bone must have one.
+        If True, every other bone must have a column.  If False, bones
+        without a column are skipped (a preprocessor drops constant
+        channels, such as the clavicles of CMU data), but at least one bone
+        must have one.
 
     Returns
     -------
@@ -60,7 +66,7 @@ def bone_columns(feature_names, bones, *, strict=True):
     --------
     >>> from sklearn_crbm.datasets import bone_columns
     >>> names = ["root_tx", "lfemur_rx", "lfemur_ry", "ltibia_rx", "rfemur_rx"]
-    >>> bone_columns(names, ["lfemur", "ltibia"])
+    >>> bone_columns(names, ["lfemur", "ltibia", "ltibia_end"])
     array([1, 2, 3])
     >>> bone_columns(names, ["lfemur", "lclavicle"], strict=False)
     array([1, 2])
@@ -70,18 +76,25 @@ def bone_columns(feature_names, bones, *, strict=True):
     columns = []
     for bone in bones:
         found = [i for i, name in enumerate(names) if name.startswith(f"{bone}_")]
-        if not found and not strict:
+        if not found and (not strict or _end_site_of_listed_bone(bone, bones)):
             continue
         if not found:
             known = sorted({name.rsplit("_", 1)[0] for name in names})
             raise ValueError(
                 f"No column belongs to bone {bone!r}: no feature name starts with "
-                f"'{bone}_'. The bones with columns are: {known}."
+                f"'{bone}_'. The bones with columns are: {known}. To skip bones "
+                "without columns (a preprocessor drops the channels that never "
+                "change), pass strict=False."
             )
         columns.extend(found)
     if not columns:
         raise ValueError(f"None of the bones {bones} has a column in feature_names.")
     return np.array(sorted(set(columns)), dtype=np.intp)
+
+
+def _end_site_of_listed_bone(bone, bones):
+    """Whether ``bone`` is named as the end site of another of ``bones``."""
+    return bone.endswith(END_SITE_SUFFIX) and bone[: -len(END_SITE_SUFFIX)] in bones
 
 
 def frame_columns(data, feature_names, required):

@@ -35,7 +35,9 @@ def read_bvh_folder(
     Bandai Namco file the ground joint ``joint_Root`` travels while its
     ``Hips`` stay) is rewritten: the joints above are set as still as in the
     other files and the travel moved into that joint, every joint below it
-    in the same place, with a warning that names the file.
+    in the same place, with a warning that names the file.  When as many
+    files travel with one joint as with another, the lower joint is taken:
+    the result never depends on the order of the files.
 
     Parameters
     ----------
@@ -46,8 +48,9 @@ def read_bvh_folder(
         ``"**/*.bvh"`` also reads sub-folders.
     frame_rate : float, default=None
         Frame rate of the returned data.  Files recorded faster are brought
-        down to it by dropping frames (see :func:`resample_frames`).
-        ``None`` keeps the files' rate, which must then be the same for all.
+        down to it by dropping frames (see :func:`resample_frames`), with a
+        warning that names them when the files' rates differ.  ``None``
+        keeps the files' rate, which must then be the same for all.
     labels : str, re.Pattern or callable, default=None
         Where each file's label comes from:
 
@@ -68,7 +71,10 @@ def read_bvh_folder(
         must be among them.  ``None``: for a JSON key, the file
         ``{key}_label.txt`` in ``folder`` or in ``folder/../cfg`` when there
         is one (the Bandai Namco repository's ``style_label.txt``), else the
-        distinct labels in sorted order.  Without label names the labels must
+        distinct labels in sorted order (numbers in numeric order).  Names
+        read from a file lose a prefix that all of them share up to an
+        underscore: the Bandai Namco ``dataset-2_walk``, ``dataset-2_run``...
+        are ``walk``, ``run``...  Without label names the labels must
         be of one kind (all names, all integers, all booleans or all
         floats): ``true``, ``1`` and ``1.0`` are one value to Python and
         would merge into one class, so a mix is refused.  NaN is never a
@@ -84,8 +90,10 @@ def read_bvh_folder(
         target : ndarray of shape (n_frames,)
             Only with ``labels``: the code of every frame's label, an index
             into ``target_names``.
-        target_names : ndarray
-            Only with ``labels``: the label names.
+        target_names : ndarray of str
+            Only with ``labels``: the label names, as text (labels that are
+            numbers too), ready to use as class labels:
+            ``target_names[target]`` is the label of every frame.
         sequence_names : ndarray of str
             One name per file, e.g. ``"walk_01"`` or ``"subject1/walk_01"``.
         feature_names : ndarray of str
@@ -108,10 +116,13 @@ def read_bvh_folder(
         a JSON label file is missing.
     ValueError
         If a file is malformed, the files' skeletons or up axes differ,
-        their frame rates differ and ``frame_rate`` is None, a file's travel
+        their frame rates differ and ``frame_rate`` is None (the message
+        says what ``frame_rate=`` the slowest rate does to each file), a
+        file is slower than ``frame_rate``, a file is empty, a file's travel
         cannot be moved into the joint most files travel with, a file's
-        label is missing, not a finite value or not among ``label_names``.
-        The message names the file.
+        label is missing, not a finite value or not among ``label_names``
+        (a str ``labels`` is a JSON key; a label from the file names needs
+        a compiled pattern).  The message names the file.
     TypeError
         If a label is not a single name or number, or the labels mix kinds
         (``true``, ``1`` and ``1.0`` would merge into one class).
@@ -119,7 +130,8 @@ def read_bvh_folder(
     Warns
     -----
     UserWarning
-        When a file's travel is moved into another joint (see above).
+        When a file's travel is moved into another joint (see above), or
+        ``frame_rate`` drops frames of files whose rates differ.
 
     Examples
     --------
@@ -282,8 +294,8 @@ def _long_format(folder, sequences, frame_rate, kind):
     """The Bunch of :func:`read_bvh_folder` from ``(path, skeleton, data, rate)``."""
     sequences = check_agreement(sequences, frame_rate)
     first_skeleton = sequences[0][1]
-    if frame_rate is None:
-        frame_rate = sequences[0][3]
+    if frame_rate is None:  # the files' rates agree to RATIO_TOLERANCE
+        frame_rate = min(rate for _, _, _, rate in sequences)
         kept = [data for _, _, data, _ in sequences]
     else:
         frame_rate = check_rate(frame_rate, "frame_rate")

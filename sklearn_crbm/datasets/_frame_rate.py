@@ -1,13 +1,14 @@
 """Bringing sequences to a common frame rate by dropping frames."""
 
 import numbers
+from decimal import Decimal, InvalidOperation
 
 import numpy as np
 from sklearn.utils import _safe_indexing, check_consistent_length
 
 from ..utils._sequences import check_sequence_ids
 
-__all__ = ["resample_frames"]
+__all__ = ["rate_of_frame_time", "resample_frames"]
 
 # Rates read from "Frame Time: 0.008333" are 120.0048 Hz: ratios within this
 # relative tolerance of a whole number are taken as that number, so the
@@ -27,6 +28,31 @@ def check_rate(value, name):
             f"30.0, got {value!r}."
         )
     return float(value)
+
+
+def rate_of_frame_time(frame_time, written):
+    """Frames per second of a file's frame time, as its writer meant it.
+
+    ``1 / frame_time``, unless ``written`` (the frame time as the file
+    writes it, e.g. ``"0.0166667"``) is ``1 / n`` rounded to the digits
+    written, for the whole number ``n`` nearest to that rate and within
+    :data:`RATIO_TOLERANCE` of it: then ``n`` (60.0 for ``"0.0166667"``,
+    120.0 for ``"0.008333"``, where ``1 / frame_time`` is 59.9999 and
+    120.005).  Rates that are not whole numbers stay as written (29.97 for
+    ``"0.0333667"``).
+    """
+    rate = 1.0 / frame_time
+    whole = round(rate)
+    if whole < 1 or abs(rate - whole) > RATIO_TOLERANCE * whole:
+        return rate
+    try:
+        value = Decimal(written.strip())
+    except (InvalidOperation, AttributeError):
+        return rate
+    if not value.is_finite():
+        return rate
+    half_unit = Decimal(5).scaleb(value.as_tuple().exponent - 1)
+    return float(whole) if abs(1 / Decimal(whole) - value) <= half_unit else rate
 
 
 def frame_step(frame_rate, target_rate):

@@ -42,12 +42,15 @@ def file_labels(folder, paths, labels, label_names=None):
     -------
     codes : ndarray of shape (n_files,)
         Index into ``names`` of each file's label.
-    names : ndarray
-        The label names.
+    names : ndarray of str
+        The label names, as text.  Names read from a file lose a prefix
+        that all of them share up to an underscore (``"dataset-2_"`` of the
+        Bandai Namco ``style_label.txt``).
     """
     if isinstance(labels, str):
         sources = [path.with_suffix(".json").name for path in paths]
-        values = [_json_label(path, labels) for path in paths]
+        hint = _pattern_hint(labels, paths)
+        values = [_json_label(path, labels, hint) for path in paths]
         if label_names is None:
             label_names = _label_name_file(folder, labels)
     elif isinstance(labels, re.Pattern):
@@ -67,8 +70,23 @@ def file_labels(folder, paths, labels, label_names=None):
     ]
     if label_names is None:
         _check_one_kind(values, sources)
-        return _codes_of_distinct_values(values)
-    return _codes_of_named_values(values, _read_names(label_names), paths)
+        codes, names = _codes_of_distinct_values(values)
+    else:
+        codes, names = _codes_of_named_values(values, _read_names(label_names), paths)
+        if isinstance(label_names, str | os.PathLike):
+            names = _without_shared_prefix(names)
+    return codes, _as_array([str(name) for name in names])
+
+
+def _without_shared_prefix(names):
+    """``names`` without the prefix all of them share up to an underscore
+    (``"dataset-2_walk"``, ``"dataset-2_run"``: ``"walk"``, ``"run"``), if
+    they stay distinct and non-empty."""
+    cut = os.path.commonprefix(list(names)).rfind("_") + 1
+    short = [name[cut:] for name in names]
+    if len(names) < 2 or not cut or not all(short) or len(set(short)) < len(short):
+        return names
+    return short
 
 
 def _checked_label(value, source):
@@ -110,7 +128,7 @@ def _check_one_kind(values, sources):
         )
 
 
-def _json_label(path, key):
+def _json_label(path, key, hint):
     json_path = path.with_suffix(".json")
     try:
         with open(json_path, encoding="utf-8") as f:
@@ -118,8 +136,7 @@ def _json_label(path, key):
     except FileNotFoundError:
         raise FileNotFoundError(
             f"{path.name} has no label file {json_path.name} beside it; labels="
-            f"{key!r} reads the label from a JSON file of the same name. Give "
-            "labels as a regular expression or a function of the path instead."
+            f"{key!r} reads the label from a JSON file of the same name. {hint}"
         ) from None
     except UnicodeDecodeError as exc:
         raise ValueError(f"{json_path} is not UTF-8 text: {exc}.") from None
@@ -131,8 +148,27 @@ def _json_label(path, key):
         raise ValueError(f"{json_path} is not valid JSON: {exc}.") from None
     if not isinstance(content, dict) or key not in content:
         found = sorted(content) if isinstance(content, dict) else type(content).__name__
-        raise ValueError(f"{json_path} has no key {key!r}; it has {found}.")
+        raise ValueError(
+            f"{json_path} has no key {key!r}; it has {found}. A str labels= is a "
+            f"key of the JSON file beside each motion file. {hint}"
+        )
     return content[key]
+
+
+def _pattern_hint(key, paths):
+    """How to take the label from the file names instead of the JSON key
+    ``key``: a pattern with a group, which the command line's ``--labels``
+    tells from a key."""
+    example = "walk_([a-z]+)_"
+    if "_" in key.strip("_") and any(key in path.stem for path in paths):
+        # 'dataset-2_run' of 'dataset-2_run_normal_001': a name, whose last
+        # part is probably the label
+        example = f"{key.strip('_').rsplit('_', 1)[0]}_([^_]+)"
+    return (
+        "To take the label from the file names, give a pattern with a group "
+        f"around the label: labels=re.compile(r'{example}') (on the command line, "
+        f"--labels '{example}'; without a group, --labels is a key)."
+    )
 
 
 def _name_label(folder, path, pattern):
@@ -189,7 +225,7 @@ def _codes_of_distinct_values(values):
             f"({sorted({type(v).__name__ for v in values})}); give label_names."
         ) from None
     index = {name: code for code, name in enumerate(names)}
-    return np.array([index[v] for v in values], dtype=np.intp), _as_array(names)
+    return np.array([index[v] for v in values], dtype=np.intp), names
 
 
 def _codes_of_named_values(values, names, paths):
@@ -211,7 +247,7 @@ def _codes_of_named_values(values, names, paths):
                 f"{path.name} has label {value!r}, which is not one of the label "
                 f"names {names}."
             )
-    return np.array(codes, dtype=np.intp), _as_array(names)
+    return np.array(codes, dtype=np.intp), names
 
 
 def _as_array(names):

@@ -66,6 +66,9 @@ def read_lines(path):
         If ``path`` is not a str, bytes or path-like object.
     OSError
         If the file cannot be read (e.g. it does not exist).
+    ValueError
+        If the file is empty or holds only whitespace, as a failed download
+        leaves it: no motion file is.
     """
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise TypeError(
@@ -73,7 +76,14 @@ def read_lines(path):
             f"{type(path).__name__} {path!r}."
         )
     with open(path, encoding="utf-8", errors="replace") as f:
-        return [(i, line.rstrip("\r\n")) for i, line in enumerate(f, start=1)]
+        lines = [(i, line.rstrip("\r\n")) for i, line in enumerate(f, start=1)]
+    if not any(text.strip() for _, text in lines):
+        what = "holds only blank lines" if lines else "has no content (0 bytes)"
+        raise ValueError(
+            f"{os.fsdecode(path)} is empty: the file {what}. A download or copy "
+            "that failed? Fetch or export the file again."
+        )
+    return lines
 
 
 def parse_floats(tokens, path, lineno, what="value"):

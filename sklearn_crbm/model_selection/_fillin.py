@@ -79,7 +79,9 @@ def erasure_mask(
         Where it ends (excluded), in the units of ``start``; ``None`` is the
         end of every sequence.
     strict : bool, default=True
-        Whether every bone in ``bones`` must have a channel.  With False,
+        Whether every bone in ``bones`` must have a channel, end sites
+        listed with their joint excepted (they have none, so the bones of
+        ``skeleton.descendants(...)`` need no False).  With False,
         bones without one are skipped (a preprocessor drops constant
         channels, such as the clavicles of CMU data), but at least one bone
         must have one.

@@ -13,6 +13,7 @@ from sklearn_crbm.datasets import (
     make_walker,
     read_amc,
     read_bvh,
+    read_bvh_folder,
     write_bvh,
 )
 
@@ -60,6 +61,30 @@ def small_bvh(tmp_path):
 
 def _line_error(path, lineno):
     return re.escape(f"{path}, line {lineno}:")
+
+
+@pytest.mark.parametrize(
+    "frame_time, rate",
+    [
+        ("0.0166667", 60.0),  # 59.99988 as 1 / Frame Time
+        ("0.008333", 120.0),  # 120.0048
+        ("0.0333333", 30.0),
+        ("1.6666667e-02", 60.0),
+        ("0.0416667", 24.0),
+        ("0.04", 25.0),
+        ("0.03333333333333333", 30.0),  # what write_bvh writes for 30
+        ("0.0333667", 1 / 0.0333667),  # 29.97: not a whole number
+        ("0.03", 1 / 0.03),  # 33.3: 1 / 33 written to two digits, but 1% off
+        ("0.0166", 1 / 0.0166),  # 60.24: 1 / 60 is 0.0167 to four digits
+    ],
+)
+def test_frame_rates_are_read_as_written(small_bvh, frame_time, rate):
+    small_bvh.write_text(SMALL_BVH.replace("0.04", frame_time))
+    assert read_bvh(small_bvh)[3] == rate
+    other = small_bvh.with_name("other.bvh")
+    other.write_text(SMALL_BVH.replace("0.04", "0.1"))
+    with pytest.raises(ValueError, match=f" has {rate:g} frames per second"):
+        read_bvh_folder(small_bvh.parent)
 
 
 def test_read_small_bvh(small_bvh):

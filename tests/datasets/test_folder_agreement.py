@@ -4,6 +4,7 @@ One odd file must not change the data of the others silently: it is
 reconciled with a warning that names it, or refused with an error that does.
 """
 
+import re
 import shutil
 
 import numpy as np
@@ -70,7 +71,10 @@ def test_a_file_whose_ground_joint_travels_is_reconciled(tmp_path):
 def test_a_file_whose_pelvis_travels_below_a_travelling_root_is_refused(tmp_path):
     for name, root_moves in (("a", True), ("b", True), ("odd", False)):
         (tmp_path / f"{name}.bvh").write_text(_two_joint_bvh(root_moves))
-    with pytest.raises(ValueError, match=r"odd\.bvh.*'H'.*'R'"):
+    # the message names the files the others travel with, too
+    with pytest.raises(
+        ValueError, match=r"odd\.bvh.*'H', but with 'R' in 2 of the 3 files \(a\.bvh"
+    ):
         read_bvh_folder(tmp_path)
 
 
@@ -93,6 +97,37 @@ def test_bandai_dash_in_a_folder_of_walks(data_home, tmp_path):
         pre = make_motion_preprocessor(walks.skeleton)
         pre.fit(walks.data, sequence_ids=walks.sequence_ids)
     assert pre.named_steps["root"].root_ == "Hips"
+
+
+def test_two_files_that_disagree_give_one_result_in_either_order(data_home, tmp_path):
+    """One file travels with joint_Root, the other with Hips: whichever name
+    sorts first, the dash's travel moves into Hips, with a warning naming both."""
+    walk = data_home / "external_dev" / "bandai_namco" / "dataset-1_walk_normal_001.bvh"
+    results = []
+    for dash_name, walk_name in (("a_dash", "b_walk"), ("b_dash", "a_walk")):
+        folder = tmp_path / dash_name
+        folder.mkdir()
+        shutil.copy(data_home / "odd_files" / DASH, folder / f"{dash_name}.bvh")
+        shutil.copy(walk, folder / f"{walk_name}.bvh")
+        with pytest.warns(UserWarning) as caught:
+            both = read_bvh_folder(folder)
+        (message,) = [str(w.message) for w in caught if "travels" in str(w.message)]
+        assert re.search(
+            rf"{dash_name}\.bvh: the body travels with joint 'joint_Root', but with "
+            rf"'Hips' in 1 of the 2 files \({walk_name}\.bvh\)",
+            message,
+        )
+        names = list(both.sequence_names)
+        results.append(
+            [
+                both.data[both.sequence_ids == names.index(n)]
+                for n in (dash_name, walk_name)
+            ]
+        )
+    for first, second in zip(*results, strict=True):
+        assert_array_equal(first, second)
+    dash = results[0][0]
+    assert np.ptp(dash[:, _columns(both.feature_names, "joint_Root")]) == 0
 
 
 def _walker_file(path, up_axis="y", seed=0):
@@ -130,6 +165,35 @@ def test_files_of_another_frame_rate_are_named(tmp_path):
     write_bvh(tmp_path / "b.bvh", walker.data, walker.skeleton, 120.0)
     with pytest.raises(ValueError, match=r"b\.bvh.*120.*frame_rate="):
         read_bvh_folder(tmp_path)
+
+
+def test_a_faster_file_among_others_is_named_with_what_a_common_rate_does(
+    tmp_path, recwarn
+):
+    walker = make_walker(n_sequences=1, n_frames=12, random_state=0)
+    for name, rate in (("a", 30.0), ("b", 30.0), ("fast", 60.0)):
+        write_bvh(tmp_path / f"{name}.bvh", walker.data, walker.skeleton, rate)
+    message = (
+        r"fast\.bvh has 60 frames per second, but the other 2 files \(a\.bvh and "
+        r"b\.bvh\) have 30\. .*frame_rate=30 brings every file to 30 frames per "
+        r"second by dropping frames: it keeps every 2nd frame of fast\.bvh \(60 "
+        r"per second\) and a\.bvh and b\.bvh whole\."
+    )
+    with pytest.raises(ValueError, match=message):
+        read_bvh_folder(tmp_path)
+    assert not recwarn.list
+    # and says so when it does it
+    with pytest.warns(UserWarning, match=r"every 2nd frame of fast\.bvh"):
+        both = read_bvh_folder(tmp_path, frame_rate=30.0)
+    assert np.bincount(both.sequence_ids).tolist() == [12, 12, 6]
+    # the same files at one rate are resampled without a word
+    (tmp_path / "fast.bvh").unlink()
+    read_bvh_folder(tmp_path, frame_rate=15.0)
+    assert not [w for w in recwarn.list if "frame rate" in str(w.message)]
+    # a rate above a file's names the file
+    write_bvh(tmp_path / "slow.bvh", walker.data, walker.skeleton, 24.0)
+    with pytest.raises(ValueError, match=r"up to 30 by dropping.*slow\.bvh has 24"):
+        read_bvh_folder(tmp_path, frame_rate=30.0)
 
 
 def _dash_walk_run(data_home):

@@ -43,14 +43,15 @@ def _style_in_name(name):
 
 def test_json_labels_are_given_to_every_frame_of_their_file(styles_folder):
     walks = read_bvh_folder(styles_folder, labels="style")
-    # the names come from style_label.txt beside the files, as written there
-    assert list(walks.target_names) == [f"dataset-2_{s}" for s in STYLES]
+    # the names come from style_label.txt beside the files, without the
+    # "dataset-2_" written before every one there
+    assert list(walks.target_names) == STYLES
     assert walks.target.shape == (walks.data.shape[0],)
     for k, name in enumerate(walks.sequence_names):
         frames = walks.target[walks.sequence_ids == k]
         style = json.loads((styles_folder / f"{name}.json").read_text())["style"]
         assert_array_equal(frames, style)
-        assert walks.target_names[style] == f"dataset-2_{_style_in_name(name)}"
+        assert walks.target_names[style] == _style_in_name(name)
     assert np.bincount(walks.target).tolist() == [
         1237,
         2525,
@@ -111,13 +112,10 @@ def test_the_label_names_are_found_in_the_repositorys_cfg_folder(
     assert len(walks.target_names) == 7
     assert [
         walks.target_names[walks.target[walks.sequence_ids == k][0]] for k in (0, 1)
-    ] == [
-        "dataset-2_elderly",
-        "dataset-2_youthful",
-    ]
+    ] == ["elderly", "youthful"]
     content = read_bvh_folder(tmp_path / "data", labels="content")
     assert set(content.target) == {0}
-    assert content.target_names[0] == "dataset-2_walk"
+    assert content.target_names[0] == "walk"
     # a names file passed by path, without any beside the files
     shutil.rmtree(tmp_path / "cfg")
     walks = read_bvh_folder(
@@ -126,10 +124,70 @@ def test_the_label_names_are_found_in_the_repositorys_cfg_folder(
         label_names=styles_folder / "style_label.txt",
     )
     assert len(walks.target_names) == 7
-    # no names at all: the distinct values, sorted
+    # no names at all: the distinct values, sorted, as text
     walks = read_bvh_folder(tmp_path / "data", labels="style")
-    assert list(walks.target_names) == [1, 6]
+    assert list(walks.target_names) == ["1", "6"]
     assert_array_equal(np.unique(walks.target), [0, 1])
+
+
+def test_label_names_are_text_ready_to_use(data_home, tmp_path):
+    """target_names[target] are class labels: text, without a prefix that
+    every name of the names file repeats."""
+    contents = data_home / "bandai_contents"
+    runs = read_bvh_folder(contents, pattern="*_r*_001.bvh", labels="content")
+    assert list(runs.target_names[:4]) == [
+        "walk",
+        "walk-turn-left",
+        "walk-turn-right",
+        "run",
+    ]
+    per_frame = runs.target_names[runs.target]
+    assert set(per_frame) == {
+        "run",
+        "raise-up-both-hands",
+        "raise-up-left-hand",
+        "raise-up-right-hand",
+    }
+    assert all(isinstance(name, str) for name in per_frame)
+    # numbers are text too, in numeric order
+    walker = make_walker(n_sequences=1, n_frames=4, random_state=0)
+    for name, code in (("walk_a", 10), ("walk_b", 2), ("walk_c", 3)):
+        write_bvh(tmp_path / f"{name}.bvh", walker.data, walker.skeleton, 30.0)
+        (tmp_path / f"{name}.json").write_text(json.dumps({"take": code}))
+    takes = read_bvh_folder(tmp_path, labels="take")
+    assert list(takes.target_names) == ["2", "3", "10"]
+    # a prefix is left out only up to an underscore, and only where the
+    # names stay names; names passed as a list are kept as given
+    for names, expected in (
+        ("my_slow\nmy_brisk\nmy_slow-ish\n", ["slow", "brisk", "slow-ish"]),
+        ("slow\nslow-ish\nbrisk\n", ["slow", "slow-ish", "brisk"]),
+        ("walk_slow\nwalk_slow_fast\n", ["slow", "slow_fast"]),
+        ("a_\na_b\n", ["a_", "a_b"]),
+    ):
+        (tmp_path / "take_label.txt").write_text(names)
+        (tmp_path / "walk_a.json").write_text('{"take": 0}')
+        (tmp_path / "walk_b.json").write_text('{"take": 1}')
+        (tmp_path / "walk_c.json").write_text('{"take": 1}')
+        labelled = read_bvh_folder(tmp_path, labels="take")
+        assert list(labelled.target_names) == expected
+    kept = read_bvh_folder(tmp_path, labels="take", label_names=["my_a", "my_b"])
+    assert list(kept.target_names) == ["my_a", "my_b"]
+
+
+def test_a_file_name_given_as_key_is_told_to_have_a_group(data_home):
+    contents = data_home / "bandai_contents"
+    message = (
+        r"has no key 'dataset-2_run'; it has \['content', 'style'\]\. .* give a "
+        r"pattern with a group around the label: labels=re\.compile\("
+        r"r'dataset-2_\(\[\^_\]\+\)'\) \(on the command line, --labels "
+        r"'dataset-2_\(\[\^_\]\+\)'; without a group, --labels is a key\)"
+    )
+    with pytest.raises(ValueError, match=message):
+        read_bvh_folder(contents, pattern="*_r*_001.bvh", labels="dataset-2_run")
+    # the pattern it suggests reads the labels
+    pattern = re.compile(r"dataset-2_([^_]+)")
+    runs = read_bvh_folder(contents, pattern="*_r*_001.bvh", labels=pattern)
+    assert "run" in runs.target_names
 
 
 def test_labels_follow_the_frames_kept_at_a_lower_rate(styles_folder):

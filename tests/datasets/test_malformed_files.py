@@ -140,6 +140,26 @@ def test_readers_name_the_reader_for_the_other_format(tmp_path):
         read_amc(bvh, Skeleton.from_asf(asf))
 
 
+# ----------------------------------------------------------- empty files
+@pytest.mark.parametrize("content, what", [("", "0 bytes"), ("\n  \n", "blank")])
+def test_an_empty_file_is_said_to_be_empty(tmp_path, content, what):
+    """A download that failed leaves an empty file: say so, not 'no MOTION'."""
+    asf = _write(tmp_path, "walk.asf", ASF)
+    readers = {
+        "walk.bvh": read_bvh,
+        "skeleton.asf": Skeleton.from_asf,
+        "walk.amc": lambda path: read_amc(path, Skeleton.from_asf(asf)),
+    }
+    for name, read in readers.items():
+        path = _write(tmp_path, name, content)
+        with pytest.raises(ValueError, match=f"{name} is empty: .*{what}"):
+            read(path)
+    walker = make_walker(n_sequences=1, n_frames=4, random_state=0)
+    write_bvh(tmp_path / "good.bvh", walker.data, walker.skeleton, 30.0)
+    with pytest.raises(ValueError, match=r"walk\.bvh is empty"):
+        read_bvh_folder(tmp_path)
+
+
 # ----------------------------------------------------------- writers
 @pytest.mark.parametrize("name", ["left leg", "", "a#b", ":root", "a\nMOTION", "12"])
 def test_writers_refuse_names_their_readers_refuse(tmp_path, name):

@@ -5,7 +5,13 @@ import pytest
 import sklearn
 from numpy.testing import assert_array_equal
 
-from sklearn_crbm.datasets import Bone, Skeleton, load_cmu35, make_walker
+from sklearn_crbm.datasets import (
+    Bone,
+    Skeleton,
+    load_cmu35,
+    make_walker,
+    read_bvh_folder,
+)
 from sklearn_crbm.metrics import fillin_angle_rmse, fillin_error
 from sklearn_crbm.model_selection import (
     erasure_mask,
@@ -51,12 +57,32 @@ def test_fractions_are_relative_positions_exactly():
 def test_bones_strict_or_skipped():
     X = np.zeros((4, 3))
     names = ["root_tx", "lfemur_ex", "ltibia_ex"]
-    with pytest.raises(ValueError, match="No column belongs to bone 'lfoot'"):
+    with pytest.raises(ValueError, match="No column belongs to bone 'lfoot'.*strict"):
         erasure_mask(X, bones=["lfemur", "lfoot"], feature_names=names)
     mask = erasure_mask(X, bones=["lfemur", "lfoot"], feature_names=names, strict=False)
     assert_array_equal(mask.any(axis=0), [False, True, False])
     with pytest.raises(ValueError, match="needs feature names"):
         erasure_mask(X, bones=["lfemur"])
+
+
+def test_a_bvh_skeletons_descendants_need_no_strict_false(data_home):
+    """The end sites of a BVH skeleton have no channels, and need none."""
+    folder = data_home / "bandai_contents"
+    runs = read_bvh_folder(folder, pattern="dataset-2_run_normal_00[12].bvh")
+    left_leg = runs.skeleton.descendants("UpperLeg_L")
+    assert left_leg[-1] == "Toes_L_end"
+    names = runs.feature_names
+    mask = erasure_mask(runs.data, bones=left_leg, feature_names=names)
+    erased = {name.rsplit("_", 1)[0] for name in names[mask.any(axis=0)]}
+    assert erased == set(left_leg[:-1])
+    with sklearn.config_context(enable_metadata_routing=True):
+        pre = make_motion_preprocessor(runs.skeleton)
+        Z = pre.fit_transform(runs.data, sequence_ids=runs.sequence_ids)
+    mask = erasure_mask(Z, bones=left_leg, feature_names=pre.get_feature_names_out())
+    assert mask.any(axis=0).sum() == 12  # four joints, three angles each
+    # an end site alone, without its joint, is still a bone without columns
+    with pytest.raises(ValueError, match="'Toes_L_end'.*strict=False"):
+        erasure_mask(runs.data, bones=["Toes_L_end"], feature_names=names)
 
 
 def test_paper_body_parts_on_cmu_and_a_clear_error_elsewhere(data_home):
