@@ -133,7 +133,7 @@ def load_mat_variables(path, names, fetcher):
         mat = scipy.io.loadmat(path)
     except (FileNotFoundError, PermissionError, IsADirectoryError):
         raise
-    except (MatReadError, OSError, ValueError, TypeError, KeyError) as exc:
+    except (MatReadError, OSError, ValueError, TypeError, KeyError, IndexError) as exc:
         raise ValueError(
             f"{path} is not a readable MATLAB file ({exc}); it may be truncated or "
             f"damaged. {hint}"
