@@ -1503,10 +1503,10 @@ OTHER_PARAMS = [
         "reference_features has 2 rows but reference_styles has 1 labels",
     ),
     Case(
-        "plotting.plot_skeleton(view='top')",
-        lambda c: plotting.plot_skeleton(c.skeleton, c.walker.data[0], view="top"),
+        "plotting.plot_skeleton(view='bottom')",
+        lambda c: plotting.plot_skeleton(c.skeleton, c.walker.data[0], view="bottom"),
         ValueError,
-        "view must be 'side' or '3d'",
+        "view must be one of 'front', 'side', 'top', '3d', got 'bottom'",
     ),
     Case(
         "plotting.plot_motion_strip(step=0)",
