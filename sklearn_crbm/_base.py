@@ -77,6 +77,8 @@ LIVELINESS_FRAMES = 100
 DEAD_FRACTION = 0.5
 BLOWN_DEVIATIONS = 10.0
 BLOWN_REACH = 2.0
+# Frames at a time over which fit's statistics are summed (no copy of X).
+STATISTICS_CHUNK = 8192
 
 
 class BaseCRBM(
@@ -1144,17 +1146,15 @@ def generation_statistics(X, sequences, labels=None):
     that mean for each style alone, each sequence weighted by its frames'
     weight for the style, and ``label_weight``: those weights' sums.
     """
-    X = to_numpy(X).astype(np.float64, copy=False)
-    amplitudes = motion_amplitude(
-        X, sequence_ids=sequences.per_frame_ids(), last_frames=LIVELINESS_FRAMES
-    )
+    X = to_numpy(X)
     weights = np.minimum(sequences.lengths, LIVELINESS_FRAMES)
-    mean = X.mean(axis=0)
+    amplitudes = _last_frames_amplitude(X, sequences.stops, weights)
+    mean, scale, reach = _channel_moments(X)
     statistics = Bunch(
         mean=mean,
-        scale=float(X.std(axis=0).max()),
+        scale=float(scale.max()),
         amplitude=float(np.average(amplitudes, weights=weights)),
-        reach=np.abs(X - mean).max(axis=0),
+        reach=reach,
         n_frames=X.shape[0],
     )
     if labels is not None:
@@ -1172,6 +1172,77 @@ def generation_statistics(X, sequences, labels=None):
             label_amplitude=_ratio(weighted, label_weight), label_weight=label_weight
         )
     return statistics
+
+
+def _last_frames_amplitude(X, stops, n_last, chunk=STATISTICS_CHUNK):
+    """:func:`motion_amplitude` of the ``n_last`` frames before each stop.
+
+    A few sequences at a time, so that at most about ``chunk`` frames are
+    copied (``motion_amplitude`` works in float64).
+    """
+    amplitudes = []
+    group_ends = np.cumsum(n_last)
+    first = 0
+    while first < len(stops):
+        last = int(
+            np.searchsorted(group_ends, group_ends[first] - n_last[first] + chunk)
+        )
+        last = max(last, first + 1)
+        rows = np.concatenate(
+            [
+                np.arange(stop - n, stop)
+                for stop, n in zip(stops[first:last], n_last[first:last], strict=True)
+            ]
+        )
+        ids = np.repeat(np.arange(last - first), n_last[first:last])
+        amplitudes.append(motion_amplitude(X[rows], sequence_ids=ids))
+        first = last
+    return np.concatenate(amplitudes)
+
+
+def _channel_moments(X, chunk=STATISTICS_CHUNK):
+    """Every channel's mean, standard deviation and largest distance from it.
+
+    Bit for bit what ``X.astype(np.float64)``'s ``mean(axis=0)``,
+    ``std(axis=0)`` and ``np.abs(X - mean).max(axis=0)`` give, without a
+    float64 copy of the whole of ``X``.  numpy sums a contiguous column
+    pairwise, so a column-ordered ``X`` (or a single channel) goes one column
+    at a time; it sums the rows of a row-ordered array one after the other,
+    so any other ``X`` goes ``chunk`` frames at a time, each chunk summed
+    after the running total, put as its first row.
+    """
+    if X.shape[1] == 1 or (X.flags.f_contiguous and not X.flags.c_contiguous):
+        chunk = max(X.shape[0], 1)
+        columns = [X[:, [j]] for j in range(X.shape[1])]
+    else:
+        columns = [X]
+    moments = [_row_chunk_moments(part, chunk) for part in columns]
+    return tuple(np.concatenate(moment) for moment in zip(*moments, strict=True))
+
+
+def _row_chunk_moments(X, chunk):
+    """:func:`_channel_moments` of ``X`` summed ``chunk`` rows at a time."""
+
+    def chunks():
+        for start in range(0, X.shape[0], chunk):
+            yield np.array(X[start : start + chunk], dtype=np.float64, order="C")
+
+    def column_sum(rows_of):
+        total = None
+        for rows in chunks():
+            rows = rows_of(rows)
+            if total is not None:
+                rows = np.concatenate([total[None], rows])
+            total = np.add.reduce(rows, axis=0)
+        return total
+
+    n_frames = X.shape[0]
+    mean = column_sum(lambda rows: rows) / n_frames
+    square = column_sum(lambda rows: np.square(rows - mean, out=rows))
+    reach = np.zeros_like(mean)
+    for rows in chunks():
+        np.maximum(reach, np.abs(rows - mean, out=rows).max(axis=0), out=reach)
+    return mean, np.sqrt(square / n_frames), reach
 
 
 def _ratio(numerator, denominator):
