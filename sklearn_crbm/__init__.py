@@ -14,6 +14,7 @@ from ._crbm import ConditionalRBM
 from ._factored import FactoredCRBM
 from ._labelled import LabelledCRBM
 from ._stacked import StackedCRBM
+from ._version import __version__
 from .exceptions import TrainingDivergedError
 from .impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from .preprocessing import (
@@ -22,8 +23,6 @@ from .preprocessing import (
     StandardScaler,
     make_motion_preprocessor,
 )
-
-__version__ = "0.1.0.dev0"
 
 __all__ = [
     "AutoregressiveImputer",

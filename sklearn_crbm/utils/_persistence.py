@@ -29,6 +29,8 @@ from functools import reduce
 import sklearn
 from sklearn.exceptions import InconsistentVersionWarning
 
+from .._version import __version__
+
 __all__ = [
     "PICKLE_FORMAT",
     "VersionedPickleMixin",
@@ -51,15 +53,9 @@ MOVED_MODULES = {
 }
 
 
-def _package_version():
-    from .. import __version__
-
-    return __version__
-
-
 def _refit_advice(name):
     return (
-        f"Refit the {name} with sklearn_crbm {_package_version()} and save it "
+        f"Refit the {name} with sklearn_crbm {__version__} and save it "
         "again (or load it with the release that saved it)."
     )
 
@@ -68,7 +64,7 @@ def check_pickle_format(saved_format, name, saved_by="an older sklearn_crbm"):
     """Raise a ValueError unless ``saved_format`` is the format this code reads."""
     if saved_format == PICKLE_FORMAT:
         return
-    reads = f"sklearn_crbm {_package_version()} reads pickle format {PICKLE_FORMAT}"
+    reads = f"sklearn_crbm {__version__} reads pickle format {PICKLE_FORMAT}"
     if saved_format is None:
         raise ValueError(
             f"This {name} was pickled by {saved_by} that recorded no pickle format "
@@ -92,7 +88,7 @@ def raise_removed_layout(module, name):
     raise ValueError(
         f"This model was pickled by an sklearn_crbm from before the layer "
         f"redesign of November 2026 (pickle format 0): its fitted parameters are "
-        f"a {module}.{name}, a layout that sklearn_crbm {_package_version()} "
+        f"a {module}.{name}, a layout that sklearn_crbm {__version__} "
         f"(pickle format {PICKLE_FORMAT}) no longer reads. " + _refit_advice("model")
     )
 
@@ -148,7 +144,7 @@ class VersionedPickleMixin:
 
     def __reduce_ex__(self, protocol):
         cls = type(self)
-        saved = (PICKLE_FORMAT, _package_version(), cls.__module__, cls.__qualname__)
+        saved = (PICKLE_FORMAT, __version__, cls.__module__, cls.__qualname__)
         return _unpickle, saved, self.__getstate__()
 
     def __getstate__(self):
