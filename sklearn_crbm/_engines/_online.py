@@ -25,15 +25,15 @@ from numbers import Real
 
 import numpy as np
 
+from ..layers._base import sequence_hidden_probabilities
+from ..utils._array_api import array_ops, copy_array, to_numpy
+from ..utils._sequences import Sequences
 from ._gibbs import (
     gibbs_frames,
     observed_log_likelihood,
     stacked_gibbs_frames,
     stacked_prediction,
 )
-from .layers._base import sequence_hidden_probabilities
-from .utils._array_api import array_ops, copy_array, to_numpy
-from .utils._sequences import Sequences
 
 __all__ = [
     "TOP_LAYER",
@@ -53,7 +53,7 @@ given its own past).  Every layer's past is the values that pass produced.
 Nothing can be clamped: the data sit at the bottom."""
 WHOLE_STACK = "whole_stack"
 """Every Gibbs iteration goes up the stack and down again
-(:func:`~sklearn_crbm._gibbs.stacked_gibbs_frames`), so the state of the
+(:func:`~sklearn_crbm._engines._gibbs.stacked_gibbs_frames`), so the state of the
 chain is the frame itself and its observed channels can be clamped.  The
 upper layers' past is the final frame passed up (hidden probabilities)."""
 
@@ -239,7 +239,7 @@ class Offsets:
     typical values (a slow posture channel towards the training posture);
     while a channel is observed, its one-step residual ``r_t = x_t -
     x_hat_t`` (``x_hat_t`` the chain's mean-field prediction of the frame
-    from its past, :func:`~sklearn_crbm._gibbs.stacked_prediction`) shows
+    from its past, :func:`~sklearn_crbm._engines._gibbs.stacked_prediction`) shows
     that error.  The correction of a missing entry is the posterior mean of
     a constant offset ``d`` behind the residuals, ``r_t = d + noise``, with a
     prior worth ``shrinkage`` frames of zero residual: ``sum(r) / (n +
@@ -614,7 +614,7 @@ def _ancestors(stack, frames, observed, n_particles, rng):
 
     A particle's weight is the likelihood of the frame's observed channels
     under its own one-step prediction from ``stack``, its frame RBMs
-    (:func:`~sklearn_crbm._gibbs.observed_log_likelihood`); each group is
+    (:func:`~sklearn_crbm._engines._gibbs.observed_log_likelihood`); each group is
     resampled (systematic resampling).  Returns the ancestors, of shape
     ``(n_chains, n_sequences)``, as :meth:`History.reorder` takes them.
     """

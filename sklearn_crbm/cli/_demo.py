@@ -11,11 +11,11 @@ import time
 import numpy as np
 from sklearn.impute import KNNImputer
 
-from .._base import DEAD_FRACTION, generated_liveliness
 from ..datasets import write_amc, write_bvh
 from ..impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from ..metrics import judge_generated_motion
 from ..model_selection import compare_imputers, make_fillin_cases
+from ..models._base import DEAD_FRACTION, generated_liveliness
 from ..preprocessing import make_motion_preprocessor
 from ..utils import random_windows
 

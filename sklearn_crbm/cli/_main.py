@@ -17,9 +17,6 @@ import numpy as np
 import sklearn
 from sklearn.utils import Bunch
 
-from .._base import generated_liveliness
-from .._crbm import ConditionalRBM
-from .._factored import FactoredCRBM
 from ..datasets import (
     fetch_bandai_walks,
     fetch_cmu35,
@@ -31,6 +28,9 @@ from ..datasets import (
     read_bvh_folder,
     resample_frames,
 )
+from ..models._base import generated_liveliness
+from ..models._crbm import ConditionalRBM
+from ..models._factored import FactoredCRBM
 from ..preprocessing import MotionContext, MotionPipeline, make_motion_pipeline
 from ._demo import liveliness_text, save_gif
 from ._demo import run_demo as _run_demo

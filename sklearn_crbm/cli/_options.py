@@ -5,8 +5,8 @@ import math
 import tempfile
 from pathlib import Path
 
-from .._crbm import ConditionalRBM
-from .._factored import FactoredCRBM
+from ..models._crbm import ConditionalRBM
+from ..models._factored import FactoredCRBM
 
 __all__ = ["COMMANDS", "DEMO_OUTPUT", "STYLES_OUTPUT"]
 

@@ -2,7 +2,7 @@
 
 :class:`BaseCRBM` is the base of :class:`~sklearn_crbm.ConditionalRBM`,
 :class:`~sklearn_crbm.StackedCRBM` and, through
-:class:`~sklearn_crbm._base_layer.BaseLayerModel`, of the style models
+:class:`~sklearn_crbm.models._one_layer.BaseLayerModel`, of the style models
 :class:`~sklearn_crbm.FactoredCRBM` and :class:`~sklearn_crbm.LabelledCRBM`.
 """
 
@@ -28,22 +28,22 @@ from sklearn.utils.validation import (
     validate_data,
 )
 
-from ._gibbs import stacked_prediction
-from ._likelihood import (
+from .._engines._gibbs import stacked_prediction
+from .._engines._likelihood import (
     LogLikelihood,
     frame_log_likelihood,
     stack_log_likelihood_bound,
 )
-from ._online import TOP_LAYER, History, run_online
-from .exceptions import GenerationWarning
-from .layers._base import sequence_frame_rbms, sequence_hidden_probabilities
-from .metrics import motion_amplitude
-from .utils._array_api import array_ops, array_random, is_numpy, to_numpy
-from .utils._parallel import SAMPLE_BLOCK, map_sequence_blocks
-from .utils._persistence import VersionedPickleMixin
-from .utils._random import rng_from
-from .utils._sequences import check_sequence_ids
-from .utils._threads import frame_rows, limit_blas_threads, sequence_rows
+from .._engines._online import TOP_LAYER, History, run_online
+from ..exceptions import GenerationWarning
+from ..layers._base import sequence_frame_rbms, sequence_hidden_probabilities
+from ..metrics import motion_amplitude
+from ..utils._array_api import array_ops, array_random, is_numpy, to_numpy
+from ..utils._parallel import SAMPLE_BLOCK, map_sequence_blocks
+from ..utils._persistence import VersionedPickleMixin
+from ..utils._random import rng_from
+from ..utils._sequences import check_sequence_ids
+from ..utils._threads import frame_rows, limit_blas_threads, sequence_rows
 
 __all__ = [
     "BaseCRBM",
@@ -570,7 +570,7 @@ n_classes), default=None
     def _log_likelihood(
         self, X, sequences, method="auto", reverse=False, rng=None, context=None
     ):
-        """:class:`~sklearn_crbm._likelihood.LogLikelihood` of every frame."""
+        """:class:`~sklearn_crbm._engines._likelihood.LogLikelihood` of every frame."""
         layers = self._layers()
         n_steps, n_chains = self._ais_settings()
         rng = rng_from(self.random_state) if rng is None else rng
@@ -1371,7 +1371,7 @@ def lifeless_message(frames, n_frames, statistics, scale=None, labels=None):
 def _caller_level():
     """The ``stacklevel`` that points a warning at the first caller outside the
     package (through ``MotionPipeline.sample`` and the thread decorators)."""
-    package = os.path.dirname(os.path.abspath(__file__))
+    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))  # models/..
     frame, level = inspect.currentframe().f_back, 1
     while frame is not None and frame.f_code.co_filename.startswith(package):
         frame, level = frame.f_back, level + 1

@@ -9,17 +9,17 @@ from sklearn.utils._array_api import (
 )
 from sklearn.utils._param_validation import Interval, StrOptions
 
-from ._base import FittedParameter
-from ._base_layer import BaseLayerModel
-from .layers._base import BINARY
-from .layers._crbm import (
+from ..layers._base import BINARY
+from ..layers._crbm import (
     MIN_LOG_VARIANCE,
     ORDER_CONSTRAINTS,
     CRBMLayer,
     hidden_order_of,
 )
-from .utils._array_api import array_ops
-from .utils._autoregression import ridge_autoregression
+from ..utils._array_api import array_ops
+from ..utils._autoregression import ridge_autoregression
+from ._base import FittedParameter
+from ._one_layer import BaseLayerModel
 
 # Ridge penalty of init="autoregressive": AutoregressiveImputer's default.
 _AUTOREGRESSIVE_ALPHA = 1.0

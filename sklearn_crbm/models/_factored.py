@@ -5,10 +5,10 @@ from numbers import Integral, Real
 import numpy as np
 from sklearn.utils._param_validation import Interval
 
+from ..layers._factored import FactoredLayer
+from ..utils._array_api import to_numpy
 from ._base import FittedParameter
-from ._style_model import BaseStyleModel
-from .layers._factored import FactoredLayer
-from .utils._array_api import to_numpy
+from ._style import BaseStyleModel
 
 __all__ = ["FactoredCRBM"]
 

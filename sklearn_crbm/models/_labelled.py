@@ -4,15 +4,11 @@ from numbers import Integral, Real
 
 from sklearn.utils._param_validation import Interval, StrOptions
 
+from ..layers._crbm import ORDER_CONSTRAINTS, CRBMLayer, hidden_order_of
 from ._base import FittedParameter
-from ._style_model import BaseStyleModel
-from .layers._crbm import ORDER_CONSTRAINTS, CRBMLayer, hidden_order_of
+from ._style import BaseStyleModel
 
 __all__ = ["LabelledCRBM"]
-
-# The layer of a LabelledCRBM pickled in format 1 before contexts were
-# real-valued: a CRBM layer whose context is the label weights.
-LabelledLayer = CRBMLayer
 
 
 class LabelledCRBM(BaseStyleModel):

@@ -9,13 +9,13 @@ from sklearn.utils._array_api import get_namespace
 from sklearn.utils._param_validation import HasMethods, Interval
 from sklearn.utils.validation import validate_data
 
+from ..utils._array_api import array_ops
+from ..utils._random import rng_from
+from ..utils._sequences import check_sequence_ids
+from ..utils._threads import batch_rows, limit_blas_threads
 from ._base import BaseCRBM
 from ._crbm import ConditionalRBM
-from ._style_model import _on_host
-from .utils._array_api import array_ops
-from .utils._random import rng_from
-from .utils._sequences import check_sequence_ids
-from .utils._threads import batch_rows, limit_blas_threads
+from ._style import _on_host
 
 __all__ = ["StackedCRBM"]
 
