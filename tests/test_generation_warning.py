@@ -12,7 +12,7 @@ import sklearn_crbm
 from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM, StackedCRBM
 from sklearn_crbm.datasets import make_oscillations, make_walker
 from sklearn_crbm.exceptions import GenerationWarning, TrainingDivergedError
-from sklearn_crbm.models._base import (
+from sklearn_crbm.metrics._liveliness import (
     BLOWN_DEVIATIONS,
     BLOWN_REACH,
     DEAD_FRACTION,

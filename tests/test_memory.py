@@ -4,7 +4,7 @@ import tracemalloc
 
 import numpy as np
 
-from sklearn_crbm.models._base import generation_statistics
+from sklearn_crbm.metrics._liveliness import generation_statistics
 from sklearn_crbm.utils._sequences import check_sequence_ids
 
 

@@ -14,8 +14,8 @@ from sklearn.impute import KNNImputer
 from ..datasets import write_amc, write_bvh
 from ..impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from ..metrics import judge_generated_motion
+from ..metrics._liveliness import DEAD_FRACTION, generated_liveliness
 from ..model_selection import compare_imputers, make_fillin_cases
-from ..models._base import DEAD_FRACTION, generated_liveliness
 from ..preprocessing import make_motion_preprocessor
 from ..utils import random_windows
 

@@ -28,7 +28,7 @@ from ..datasets import (
     read_bvh_folder,
     resample_frames,
 )
-from ..models._base import generated_liveliness
+from ..metrics._liveliness import generated_liveliness
 from ..models._crbm import ConditionalRBM
 from ..models._factored import FactoredCRBM
 from ..preprocessing import MotionContext, MotionPipeline, make_motion_pipeline

@@ -10,7 +10,6 @@ from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
 from sklearn.utils.validation import _is_fitted, _num_samples, check_is_fitted
 
 from .._engines._online import WHOLE_STACK, Observed, collect_fills, run_online
-from ..models._base import check_context, check_count
 from ..models._crbm import ConditionalRBM
 from ..utils._array_api import array_ops, array_random, copy_array
 from ..utils._fitting import unfitted_on_error
@@ -18,6 +17,7 @@ from ..utils._parallel import BLOCK_SEQUENCES, map_sequence_blocks
 from ..utils._random import rng_from
 from ..utils._sequences import Sequences, check_sequence_ids
 from ..utils._threads import chain_rows, limit_blas_threads
+from ..utils._validation import check_context, check_count
 from ._base import BaseMotionImputer, check_same_place
 from ._base import to_numpy as _to_numpy
 

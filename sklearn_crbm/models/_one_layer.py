@@ -120,7 +120,7 @@ class BaseLayerModel(BaseCRBM):
             xp, _ = get_namespace_and_device(X)[:2]
             X = validate_data(self, X, dtype=[xp.float64, xp.float32], reset=True)
             sequences, frames = self._check_sequences(X, sequence_ids)
-            context = self._fit_context(X, y, context, reset=True)
+            context = self._context_for_fit(X, y, context, reset=True)
             self.random_state_ = check_random_state(self.random_state)
             self._initialize(X, context)
             if self.early_stopping:
@@ -171,7 +171,7 @@ class BaseLayerModel(BaseCRBM):
                 reset=first_call,
             )
             sequences, frames = self._check_sequences(X, sequence_ids)
-            context = self._fit_context(X, y, context, reset=first_call)
+            context = self._context_for_fit(X, y, context, reset=first_call)
         with unfitted_on_error(self):
             if first_call:
                 self.random_state_ = check_random_state(self.random_state)

@@ -298,7 +298,7 @@ class StackedCRBM(BaseCRBM):
                 f"but the longest sequence has {longest} {noun}. Pass longer "
                 "sequences (check sequence_ids), fewer layers or a lower order."
             )
-        return X, sequences, self._fit_context(X, None, context, reset)
+        return X, sequences, self._context_for_fit(X, None, context, reset)
 
     def _pass_up(self, layer, X, y, ids, context):
         """Hidden probabilities of ``layer`` on its valid frames, with their

@@ -118,7 +118,7 @@ class BaseStyleModel(BaseLayerModel):
         """Whether the model was fitted on labels (its context: label weights)."""
         return hasattr(self, "classes_")
 
-    def _fit_context(self, X, y, context, reset):
+    def _context_for_fit(self, X, y, context, reset):
         if reset and y is None and context is None:
             raise ValueError(
                 f"{type(self).__name__} requires y to be passed, but the target y "
@@ -126,7 +126,7 @@ class BaseStyleModel(BaseLayerModel):
                 "(n_frames,)) or label weights of shape (n_frames, n_classes), or a "
                 "real-valued context= of shape (n_frames, n_context)."
             )
-        return super()._fit_context(X, y, context, reset)
+        return super()._context_for_fit(X, y, context, reset)
 
     def _labels_context(self, y, X, reset):
         if y is None:

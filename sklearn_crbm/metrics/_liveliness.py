@@ -1,0 +1,278 @@
+"""Liveliness: whether generated motion moves as much as the training motion.
+
+``fit`` keeps :func:`generation_statistics` of the training frames;
+``sample`` judges the last ``LIVELINESS_FRAMES`` frames of every generated
+sequence against them (:func:`generated_liveliness`,
+:func:`lifeless_message`).
+"""
+
+import numpy as np
+from sklearn.utils import Bunch
+
+from ..utils._array_api import to_numpy
+from ._generation import motion_amplitude
+
+__all__ = [
+    "generated_liveliness",
+    "generation_statistics",
+    "lifeless_message",
+    "merge_statistics",
+    "reference_amplitude",
+]
+
+# ``sample`` judges the last frames of every generated sequence (more than a
+# cycle of walking or waving at 30 frames per second) against the same
+# number of last frames of every training sequence: moving less than
+# DEAD_FRACTION as much, it died out; beyond BLOWN_DEVIATIONS standard
+# deviations of the widest channel from the training mean and BLOWN_REACH
+# times as far as the channel's training frames went, it blew up (the toes
+# of real walks reach 13.5 such deviations).
+LIVELINESS_FRAMES = 100
+DEAD_FRACTION = 0.5
+BLOWN_DEVIATIONS = 10.0
+BLOWN_REACH = 2.0
+# Frames at a time over which fit's statistics are summed (no copy of X).
+STATISTICS_CHUNK = 8192
+
+
+def generation_statistics(X, sequences, labels=None):
+    """What ``sample`` judges generated motion against, from the training data.
+
+    A :class:`~sklearn.utils.Bunch`: ``mean`` (every channel's mean),
+    ``scale`` (the largest channel standard deviation), ``amplitude`` (the
+    :func:`~sklearn_crbm.metrics.motion_amplitude` of the last
+    ``LIVELINESS_FRAMES`` frames of every sequence, their mean weighted by
+    those frames), ``reach`` (every channel's largest distance from its
+    mean) and ``n_frames``.  Given the frames' label weights
+    ``labels`` (shape ``(n_frames, n_classes)``), also ``label_amplitude``:
+    that mean for each style alone, each sequence weighted by its frames'
+    weight for the style, and ``label_weight``: those weights' sums.
+    """
+    X = to_numpy(X)
+    weights = np.minimum(sequences.lengths, LIVELINESS_FRAMES)
+    amplitudes = _last_frames_amplitude(X, sequences.stops, weights)
+    mean, scale, reach = _channel_moments(X)
+    statistics = Bunch(
+        mean=mean,
+        scale=float(scale.max()),
+        amplitude=float(np.average(amplitudes, weights=weights)),
+        reach=reach,
+        n_frames=X.shape[0],
+    )
+    if labels is not None:
+        labels = to_numpy(labels).astype(np.float64, copy=False)
+        # each sequence's label weights summed over its last frames
+        sums = np.array(
+            [
+                labels[stop - n : stop].sum(axis=0)
+                for stop, n in zip(sequences.stops, weights, strict=True)
+            ]
+        )
+        label_weight = sums.sum(axis=0)
+        weighted = amplitudes @ sums
+        statistics.update(
+            label_amplitude=_ratio(weighted, label_weight), label_weight=label_weight
+        )
+    return statistics
+
+
+def _last_frames_amplitude(X, stops, n_last, chunk=STATISTICS_CHUNK):
+    """:func:`motion_amplitude` of the ``n_last`` frames before each stop.
+
+    A few sequences at a time, so that at most about ``chunk`` frames are
+    copied (``motion_amplitude`` works in float64).
+    """
+    amplitudes = []
+    group_ends = np.cumsum(n_last)
+    first = 0
+    while first < len(stops):
+        last = int(
+            np.searchsorted(group_ends, group_ends[first] - n_last[first] + chunk)
+        )
+        last = max(last, first + 1)
+        rows = np.concatenate(
+            [
+                np.arange(stop - n, stop)
+                for stop, n in zip(stops[first:last], n_last[first:last], strict=True)
+            ]
+        )
+        ids = np.repeat(np.arange(last - first), n_last[first:last])
+        amplitudes.append(motion_amplitude(X[rows], sequence_ids=ids))
+        first = last
+    return np.concatenate(amplitudes)
+
+
+def _channel_moments(X, chunk=STATISTICS_CHUNK):
+    """Every channel's mean, standard deviation and largest distance from it.
+
+    Bit for bit what ``X.astype(np.float64)``'s ``mean(axis=0)``,
+    ``std(axis=0)`` and ``np.abs(X - mean).max(axis=0)`` give, without a
+    float64 copy of the whole of ``X``.  numpy sums a contiguous column
+    pairwise, so a column-ordered ``X`` (or a single channel) goes one column
+    at a time; it sums the rows of a row-ordered array one after the other,
+    so any other ``X`` goes ``chunk`` frames at a time, each chunk summed
+    after the running total, put as its first row.
+    """
+    if X.shape[1] == 1 or (X.flags.f_contiguous and not X.flags.c_contiguous):
+        chunk = max(X.shape[0], 1)
+        columns = [X[:, [j]] for j in range(X.shape[1])]
+    else:
+        columns = [X]
+    moments = [_row_chunk_moments(part, chunk) for part in columns]
+    return tuple(np.concatenate(moment) for moment in zip(*moments, strict=True))
+
+
+def _row_chunk_moments(X, chunk):
+    """:func:`_channel_moments` of ``X`` summed ``chunk`` rows at a time."""
+
+    def chunks():
+        for start in range(0, X.shape[0], chunk):
+            yield np.array(X[start : start + chunk], dtype=np.float64, order="C")
+
+    def column_sum(rows_of):
+        total = None
+        for rows in chunks():
+            rows = rows_of(rows)
+            if total is not None:
+                rows = np.concatenate([total[None], rows])
+            total = np.add.reduce(rows, axis=0)
+        return total
+
+    n_frames = X.shape[0]
+    mean = column_sum(lambda rows: rows) / n_frames
+    square = column_sum(lambda rows: np.square(rows - mean, out=rows))
+    reach = np.zeros_like(mean)
+    for rows in chunks():
+        np.maximum(reach, np.abs(rows - mean, out=rows).max(axis=0), out=reach)
+    return mean, np.sqrt(square / n_frames), reach
+
+
+def _ratio(numerator, denominator):
+    """``numerator / denominator``, NaN where the denominator is 0."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(denominator > 0, numerator / denominator, np.nan)
+
+
+def merge_statistics(old, new):
+    """The :func:`generation_statistics` of two calls of ``partial_fit``, joined."""
+    total = old.n_frames + new.n_frames
+    share = new.n_frames / total
+    mean = old.mean + share * (new.mean - old.mean)
+    merged = Bunch(
+        mean=mean,
+        scale=max(old.scale, new.scale),
+        amplitude=old.amplitude + share * (new.amplitude - old.amplitude),
+        n_frames=total,
+    )
+    if "reach" in old and "reach" in new:  # at most this far from the new mean
+        merged.reach = np.maximum(
+            old.reach + np.abs(old.mean - mean), new.reach + np.abs(new.mean - mean)
+        )
+    if "label_amplitude" in old and "label_amplitude" in new:
+        weight = old.label_weight + new.label_weight
+        weighted = [
+            np.nan_to_num(part.label_amplitude) * part.label_weight
+            for part in (old, new)
+        ]
+        merged.update(
+            label_amplitude=_ratio(weighted[0] + weighted[1], weight),
+            label_weight=weight,
+        )
+    return merged
+
+
+def reference_amplitude(statistics, labels=None):
+    """The training amplitude a generated sequence is compared with.
+
+    Given the label weights of its last frames (``labels``, shape
+    ``(n_frames, n_classes)``) and statistics of a model fitted on labels:
+    the styles' amplitudes (``label_amplitude``) weighted by the mean label
+    weights of the last ``LIVELINESS_FRAMES`` frames, so that a slow style is
+    judged against its own training takes; otherwise ``amplitude``.
+    """
+    if labels is None or "label_amplitude" not in statistics:
+        return statistics.amplitude
+    weights = to_numpy(labels)[-LIVELINESS_FRAMES:].mean(axis=0)
+    known = np.isfinite(statistics.label_amplitude)
+    if not np.any(weights[known] > 0):
+        return statistics.amplitude
+    return float(np.average(statistics.label_amplitude[known], weights=weights[known]))
+
+
+def generated_liveliness(frames, n_frames, statistics, labels=None):
+    """How much every generated sequence moves at its end, against training.
+
+    The amplitude (:func:`~sklearn_crbm.metrics.motion_amplitude`) of the
+    last ``LIVELINESS_FRAMES`` frames of every sequence of ``frames`` (long
+    format, ``n_frames`` each) over :func:`reference_amplitude` (the
+    training sequences', or those of the styles ``labels`` ask for): 1 moves
+    as much as they do; NaN where fewer frames were generated.
+    """
+    n_sequences = len(frames) // n_frames
+    reference = reference_amplitude(statistics, labels)
+    if n_frames < LIVELINESS_FRAMES or not reference > 0:
+        return np.full(n_sequences, np.nan)
+    amplitude = motion_amplitude(
+        np.nan_to_num(frames),  # what blew up is judged as blown, not here
+        sequence_ids=np.repeat(np.arange(n_sequences), n_frames),
+        last_frames=LIVELINESS_FRAMES,
+    )
+    return amplitude / reference
+
+
+def lifeless_message(frames, n_frames, statistics, scale=None, labels=None):
+    """What went wrong with generated ``frames`` (long format), or "" if nothing.
+
+    A sequence blew up when a value is non-finite, or more than
+    ``BLOWN_DEVIATIONS`` times ``scale`` (default ``statistics.scale``) from
+    the training mean and ``BLOWN_REACH`` times as far as its channel's
+    training values went (``statistics.reach``, where kept);
+    it died out when its :func:`generated_liveliness` (against the styles
+    the label weights ``labels`` ask for, if given) is below
+    ``DEAD_FRACTION`` (judged only when ``LIVELINESS_FRAMES`` frames or more
+    were generated).
+    """
+    sequences = frames.reshape(-1, n_frames, frames.shape[1])
+    with np.errstate(invalid="ignore", over="ignore"):
+        scale = statistics.scale if scale is None else scale
+        distance = np.abs(sequences - statistics.mean) / scale
+        distance = np.where(np.isfinite(distance), distance, np.inf)
+        limit = BLOWN_DEVIATIONS
+        if "reach" in statistics:
+            limit = np.maximum(limit, BLOWN_REACH * statistics.reach / scale)
+        over = (distance > limit).any(axis=(1, 2))
+    reach = distance.max(axis=(1, 2))
+    blown = np.flatnonzero(over)
+    liveliness = generated_liveliness(frames, n_frames, statistics, labels)
+    dead = np.setdiff1d(np.flatnonzero(liveliness < DEAD_FRACTION), blown)
+    compared = "the training sequences"
+    if labels is not None and "label_amplitude" in statistics:
+        compared += " of the style asked for"
+    parts = []
+    if len(blown):
+        parts.append(
+            f"{_count(blown, len(sequences))} blew up (values up to "
+            f"{reach[blown].max():.3g} training standard deviations from the "
+            "training mean, beyond where the training frames went, or "
+            "non-finite). Train longer (n_iter), lower "
+            "learning_rate, or seed with real frames (history=)."
+        )
+    if len(dead):
+        parts.append(
+            f"{_count(dead, len(sequences))} died out: over the last "
+            f"{LIVELINESS_FRAMES} frames, moving at most "
+            f"{liveliness[dead].max():.2f} times as much as {compared} "
+            f"(below {DEAD_FRACTION}: the motion came to rest). "
+            "Train for more updates (raise n_iter) or on more frames, or seed "
+            "with real frames of the motion wanted (history=); see the user "
+            "guide's 'Training on your own corpus'."
+        )
+    return " ".join(parts)
+
+
+def _count(indices, n_sequences):
+    """``"Sequence 2 of 3"`` or ``"Sequences 0, 2 of 3"``."""
+    noun = "Sequence" if len(indices) == 1 else "Sequences"
+    listed = ", ".join(str(int(k)) for k in indices[:10])
+    more = ", ..." if len(indices) > 10 else ""
+    return f"{noun} {listed}{more} of {n_sequences}"
