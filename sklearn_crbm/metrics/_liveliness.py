@@ -1,19 +1,30 @@
-"""Liveliness: whether generated motion moves as much as the training motion.
+"""Liveliness: whether motion moves as much as real motion does.
 
-``fit`` keeps :func:`generation_statistics` of the training frames;
-``sample`` judges the last ``LIVELINESS_FRAMES`` frames of every generated
-sequence against them (:func:`generated_liveliness`,
-:func:`lifeless_message`).
+:func:`liveliness` compares any motion with real motion, on the channels
+that move most in the real one.  ``fit`` keeps
+:func:`generation_statistics` of the training frames; ``sample`` judges the
+last ``LIVELINESS_FRAMES`` frames of every generated sequence against them
+(:func:`generated_liveliness`, :func:`lifeless_message`).
 """
+
+from numbers import Integral
 
 import numpy as np
 from sklearn.utils import Bunch
 
 from ..utils._array_api import to_numpy
-from ._generation import motion_amplitude
+from ._generation import (
+    _check_motion,
+    _check_motion_pair,
+    _columns,
+    _segments,
+    motion_amplitude,
+)
 
 __all__ = [
     "generated_liveliness",
+    "liveliness",
+    "most_moving_channels",
     "generation_statistics",
     "lifeless_message",
     "merge_statistics",
@@ -276,3 +287,148 @@ def _count(indices, n_sequences):
     listed = ", ".join(str(int(k)) for k in indices[:10])
     more = ", ..." if len(indices) > 10 else ""
     return f"{noun} {listed}{more} of {n_sequences}"
+
+
+def _within_sequence_std(X, sequences, columns, last_frames=None):
+    """Standard deviation of every chosen column within every sequence."""
+    return np.array(
+        [
+            segment.std(axis=0)
+            for segment in _segments(X, sequences, columns, last_frames)
+        ]
+    ).reshape(-1, len(columns))
+
+
+def most_moving_channels(
+    X, *, sequence_ids=None, n_channels=12, features=None, feature_names=None
+):
+    """The channels that move most within the sequences of ``X``, most first.
+
+    Channels are ranked by their standard deviation within each sequence,
+    averaged over the sequences (weighted by their frames): what moves
+    during a take, not what differs between takes (a posture held
+    throughout one take).
+
+    Parameters
+    ----------
+    X : array-like of shape (n_frames, n_features)
+        Motion, all sequences stacked in long format.
+    sequence_ids : array-like of shape (n_frames,), default=None
+        Sequence id of every frame; ``None`` means one sequence.
+    n_channels : int, default=12
+        How many channels (fewer if fewer are chosen from).
+    features : list of str or int, default=None
+        The channels to choose from, by name or column index (for example
+        the joint angles alone, in one unit); ``None`` means all.
+    feature_names : array-like of str, default=None
+        Names of the columns of ``X``; default the columns of a DataFrame.
+
+    Returns
+    -------
+    columns : ndarray of int of shape (n_channels,)
+        Column indices into ``X``, the most moving first.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn_crbm.metrics import most_moving_channels
+    >>> t = np.arange(100)
+    >>> X = np.column_stack([np.sin(t / 5), 3 * np.sin(t / 5), np.ones(100)])
+    >>> most_moving_channels(X, n_channels=2)
+    array([1, 0])
+    """
+    if isinstance(n_channels, bool) or not isinstance(n_channels, Integral):
+        raise ValueError(f"n_channels must be a positive integer, got {n_channels!r}.")
+    if n_channels < 1:
+        raise ValueError(f"n_channels must be a positive integer, got {n_channels!r}.")
+    X, sequences, names = _check_motion(X, sequence_ids, feature_names)
+    columns = _columns(features, names, X.shape[1])
+    spread = np.average(
+        _within_sequence_std(X, sequences, columns), axis=0, weights=sequences.lengths
+    )
+    order = np.argsort(-spread, kind="stable")
+    return columns[order[:n_channels]]
+
+
+def liveliness(
+    X,
+    X_reference,
+    *,
+    sequence_ids=None,
+    reference_sequence_ids=None,
+    n_channels=12,
+    features=None,
+    feature_names=None,
+    last_frames=None,
+):
+    """How much each sequence moves, as a fraction of how much real motion does.
+
+    The ``n_channels`` channels that move most in the reference motion
+    (:func:`most_moving_channels`) are the ones judged.  A sequence's
+    liveliness is the mean, over those channels, of its standard deviation
+    over its frames (only the last ``last_frames``, where given), divided
+    by the same mean for the reference sequences (their within-sequence
+    standard deviations, averaged weighted by frames).  1 is as lively as
+    the reference; generated motion that dies out into a pose goes to 0.
+    Compare in units where the channels are alike (for example the joint
+    angles of the exponential maps, in radians, before standard scaling).
+
+    Parameters
+    ----------
+    X : array-like of shape (n_frames, n_features)
+        The motion to judge (for example generated), sequences stacked.
+    X_reference : array-like of shape (n_reference_frames, n_features)
+        Real motion in the same representation (for example the training
+        takes).
+    sequence_ids : array-like of shape (n_frames,), default=None
+        Sequence id of every frame of ``X``; ``None`` means one sequence.
+    reference_sequence_ids : array-like of shape (n_reference_frames,), default=None
+        Sequence id of every frame of ``X_reference``.
+    n_channels : int, default=12
+        How many of the most moving channels are judged.
+    features : list of str or int, default=None
+        The channels to choose from, by name or column index; ``None``
+        means all.
+    feature_names : array-like of str, default=None
+        Names of the columns of both arrays; default the columns of ``X``
+        if it is a DataFrame.
+    last_frames : int, default=None
+        Judge only the last ``last_frames`` frames of each sequence of ``X``.
+
+    Returns
+    -------
+    liveliness : ndarray of shape (n_sequences,)
+        Non-negative; 1 is as lively as the reference.
+
+    See Also
+    --------
+    motion_amplitude : The amplitude of chosen channels, in their units.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn_crbm.metrics import liveliness
+    >>> t = np.arange(200)
+    >>> real = np.column_stack([np.sin(t / 5), np.cos(t / 5)])
+    >>> fading = real * np.exp(-t / 50)[:, None]
+    >>> liveliness(np.vstack([real, fading]), real, n_channels=2,
+    ...            sequence_ids=np.repeat([0, 1], 200), last_frames=100).round(2)
+    array([1.  , 0.07])
+    """
+    X, sequences, names, X_reference, reference = _check_motion_pair(
+        X, X_reference, sequence_ids, reference_sequence_ids, feature_names
+    )
+    columns = most_moving_channels(
+        X_reference,
+        sequence_ids=reference.per_frame_ids(),
+        n_channels=n_channels,
+        features=_columns(features, names, X.shape[1]),
+    )
+    real = np.average(
+        _within_sequence_std(X_reference, reference, columns),
+        axis=0,
+        weights=reference.lengths,
+    ).mean()
+    if not real > 0:
+        raise ValueError("The reference motion does not move in the chosen channels.")
+    return _within_sequence_std(X, sequences, columns, last_frames).mean(axis=1) / real

@@ -1,10 +1,10 @@
 """Checks of arguments that several estimators and functions share."""
 
-from numbers import Integral
+from numbers import Integral, Real
 
 from ._array_api import array_ops
 
-__all__ = ["check_context", "check_count"]
+__all__ = ["check_context", "check_count", "check_frame_rate"]
 
 
 def check_context(context, n_frames, n_context, like, *, one_row=False):
@@ -68,3 +68,12 @@ def check_count(value, name, minimum):
     if isinstance(value, bool) or not isinstance(value, Integral) or value < minimum:
         raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}.")
     return int(value)
+
+
+def check_frame_rate(frame_rate):
+    """``frame_rate`` (frames per second) as a float; a ValueError unless positive."""
+    if isinstance(frame_rate, bool) or not isinstance(frame_rate, Real):
+        raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
+    if not frame_rate > 0:
+        raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
+    return float(frame_rate)
