@@ -104,6 +104,44 @@ class BaseCRBM(
     __metadata_request__transform = {"sequence_ids": True, "context": True}
     __metadata_request__score = {"sequence_ids": True, "context": True}
 
+    def __init__(
+        self,
+        n_components,
+        *,
+        order,
+        learning_rate,
+        momentum,
+        momentum_delay,
+        weight_decay,
+        cd_steps,
+        batch_size,
+        batching,
+        history_noise,
+        history_noise_fraction,
+        average_fraction,
+        n_iter,
+        random_state,
+        verbose,
+    ):
+        # The parameters every model has. Each subclass lists all of its own
+        # in its __init__ (scikit-learn's get_params reads them there) and
+        # passes these on, as sklearn.mixture's BaseMixture has it.
+        self.n_components = n_components
+        self.order = order
+        self.learning_rate = learning_rate
+        self.momentum = momentum
+        self.momentum_delay = momentum_delay
+        self.weight_decay = weight_decay
+        self.cd_steps = cd_steps
+        self.batch_size = batch_size
+        self.batching = batching
+        self.history_noise = history_noise
+        self.history_noise_fraction = history_noise_fraction
+        self.average_fraction = average_fraction
+        self.n_iter = n_iter
+        self.random_state = random_state
+        self.verbose = verbose
+
     # ---------------------------------------------------------------- hooks
 
     @abstractmethod
@@ -530,13 +568,7 @@ n_classes), default=None
             Mean log-likelihood per frame.
         """
         X, sequences = self._check_inference_input(X, sequence_ids, "score")
-        frames = sequences.valid_frames(self.history_length)
-        if len(frames) == 0:
-            raise ValueError(
-                f"score needs frames with {self.history_length} past frames in "
-                "their own sequence; every sequence given is shorter. Pass longer "
-                "sequences."
-            )
+        frames = sequences.frames_with_past(self.history_length, "score")
         ops = array_ops(X)
         context = self._score_context(X, y, context)
         # every frame, as score_samples draws them: the same random numbers

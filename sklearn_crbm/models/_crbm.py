@@ -227,24 +227,28 @@ class ConditionalRBM(BaseLayerModel):
         random_state=None,
         verbose=0,
     ):
-        self.n_components = n_components
-        self.order = order
+        super().__init__(
+            n_components,
+            order=order,
+            learning_rate=learning_rate,
+            momentum=momentum,
+            momentum_delay=momentum_delay,
+            weight_decay=weight_decay,
+            cd_steps=cd_steps,
+            batch_size=batch_size,
+            batching=batching,
+            history_noise=history_noise,
+            history_noise_fraction=history_noise_fraction,
+            average_fraction=average_fraction,
+            n_iter=n_iter,
+            random_state=random_state,
+            verbose=verbose,
+        )
         self.hidden_order = hidden_order
         self.visible_type = visible_type
         self.visible_variance = visible_variance
         self.init = init
         self.centering = centering
-        self.learning_rate = learning_rate
-        self.momentum = momentum
-        self.momentum_delay = momentum_delay
-        self.weight_decay = weight_decay
-        self.cd_steps = cd_steps
-        self.batch_size = batch_size
-        self.batching = batching
-        self.history_noise = history_noise
-        self.history_noise_fraction = history_noise_fraction
-        self.average_fraction = average_fraction
-        self.n_iter = n_iter
         self.ais_steps = ais_steps
         self.ais_chains = ais_chains
         self.early_stopping = early_stopping
@@ -252,8 +256,6 @@ class ConditionalRBM(BaseLayerModel):
         self.n_iter_no_change = n_iter_no_change
         self.validation_interval = validation_interval
         self.tol = tol
-        self.random_state = random_state
-        self.verbose = verbose
 
     # The training of the paper and of its released code.
     _PAPER_SCHEDULE = dict(

@@ -214,6 +214,16 @@ class Sequences:
         counts = np.maximum(self.stops - first, 0)
         return _ranges(first, counts)
 
+    def frames_with_past(self, order, needed_by):
+        """:meth:`valid_frames`; a ValueError naming ``needed_by`` if there are none."""
+        frames = self.valid_frames(order)
+        if len(frames) == 0:
+            raise ValueError(
+                f"{needed_by} needs frames with {order} past frames in their own "
+                "sequence; every sequence given is shorter. Pass longer sequences."
+            )
+        return frames
+
     def per_frame_ids(self):
         """Sequence id of every frame."""
         return np.repeat(self.ids, self.lengths)
