@@ -68,14 +68,30 @@ MOVED_CLASSES = {
     "sklearn_crbm._labelled.LabelledLayer": "sklearn_crbm.layers._crbm.CRBMLayer",
 }
 
-# Modules of a layout no longer read (the format 0 layout).
-REMOVED_MODULES = frozenset({"sklearn_crbm._crbm_math"})
+# Modules of a layout no longer read (the format 0 layout), and the classes
+# that its pickles name in them.
+REMOVED_MODULES = {
+    "sklearn_crbm._crbm_math": frozenset(
+        {
+            "CDWorkspace",
+            "CRBMParameters",
+            "HiddenSampler",
+            "MomentumUpdate",
+            "ParameterAverage",
+            "ParameterGroup",
+        }
+    ),
+}
 
 
 def _moved_attribute(old_module, name):
     """The class that a pickle names ``old_module.name``, where it lives now."""
-    if old_module in REMOVED_MODULES:
+    if name.startswith("__"):  # what tools ask of any module (__file__, ...)
+        raise AttributeError(f"module {old_module!r} has no attribute {name!r}")
+    if name in REMOVED_MODULES.get(old_module, ()):
         raise_removed_layout(old_module, name)
+    if old_module in REMOVED_MODULES:
+        raise AttributeError(f"module {old_module!r} has no attribute {name!r}")
     module, _, new_name = MOVED_CLASSES.get(
         f"{old_module}.{name}", f"{MOVED_MODULES[old_module]}.{name}"
     ).rpartition(".")
