@@ -26,3 +26,19 @@ def test_generation_statistics_do_not_copy_the_data():
     np.testing.assert_array_equal(statistics.mean, mean)
     assert statistics.scale == X64.std(axis=0).max()
     np.testing.assert_array_equal(statistics.reach, np.abs(X64 - mean).max(axis=0))
+
+
+def test_generation_statistics_of_labels_do_not_copy_them():
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(1_000_000, 8)).astype(np.float32)
+    labels = np.full((X.shape[0], 8), 1 / 8, dtype=np.float32)
+    sequences = check_sequence_ids(np.repeat(np.arange(10_000), 100), X.shape[0])
+    tracemalloc.start()
+    try:
+        base, _ = tracemalloc.get_traced_memory()
+        statistics = generation_statistics(X, sequences, labels)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak - base < labels.nbytes / 2
+    np.testing.assert_allclose(statistics.label_weight, 1_000_000 / 8)

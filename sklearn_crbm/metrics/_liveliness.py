@@ -71,11 +71,11 @@ def generation_statistics(X, sequences, labels=None):
         n_frames=X.shape[0],
     )
     if labels is not None:
-        labels = to_numpy(labels).astype(np.float64, copy=False)
+        labels = to_numpy(labels)
         # each sequence's label weights summed over its last frames
         sums = np.array(
             [
-                labels[stop - n : stop].sum(axis=0)
+                np.asarray(labels[stop - n : stop], dtype=np.float64).sum(axis=0)
                 for stop, n in zip(sequences.stops, weights, strict=True)
             ]
         )
