@@ -154,9 +154,6 @@ class StackedCRBM(BaseCRBM):
     (90, 6)
     """
 
-    # A stack pickled before ``estimator`` existed stacks ConditionalRBMs.
-    estimator = None
-
     # The hyper-parameters every layer takes from the stack as they are.
     _layer_parameters = (
         "order",
