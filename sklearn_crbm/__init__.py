@@ -10,20 +10,16 @@ models of many styles in one (the factored CRBM of Taylor & Hinton, ICML
 
 from . import datasets, exceptions, metrics, model_selection, plotting, preprocessing
 from ._config import config_context, get_config, set_config
-from ._crbm import ConditionalRBM
-from ._factored import FactoredCRBM
-from ._labelled import LabelledCRBM
-from ._stacked import StackedCRBM
+from ._version import __version__
 from .exceptions import TrainingDivergedError
 from .impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
+from .models import ConditionalRBM, FactoredCRBM, LabelledCRBM, StackedCRBM
 from .preprocessing import (
     ExpMapEncoder,
     RootRelativeEncoder,
     StandardScaler,
     make_motion_preprocessor,
 )
-
-__version__ = "0.1.0.dev0"
 
 __all__ = [
     "AutoregressiveImputer",

@@ -4,8 +4,6 @@
 :class:`TrainingDivergedError` that training produced non-finite weights.
 """
 
-from ._training import TrainingDivergedError
-
 __all__ = ["GenerationWarning", "TrainingDivergedError"]
 
 
@@ -28,3 +26,7 @@ class GenerationWarning(UserWarning):
     >>> caught[0].category.__name__
     'GenerationWarning'
     """
+
+
+class TrainingDivergedError(FloatingPointError):
+    """Training produced non-finite weights (the learning rate is too large)."""

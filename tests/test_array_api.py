@@ -36,8 +36,8 @@ from sklearn_crbm import (
     NearestNeighborImputer,
     StackedCRBM,
 )
-from sklearn_crbm._gibbs import gibbs_frames
-from sklearn_crbm._online import History, _ancestors
+from sklearn_crbm._engines._gibbs import gibbs_frames
+from sklearn_crbm._engines._online import History, _ancestors
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.layers._crbm import CRBMLayer
 from sklearn_crbm.layers._parameters import MomentumUpdate

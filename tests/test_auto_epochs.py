@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._base_layer import AUTO_EPOCHS, AUTO_UPDATES
 from sklearn_crbm.datasets import load_cmu35, make_oscillations
+from sklearn_crbm.models._one_layer import AUTO_EPOCHS, AUTO_UPDATES
 
 
 def _trainable(sequence_ids, order=3):
@@ -37,7 +37,7 @@ def test_fit_and_early_stopping_train_the_auto_epochs():
     X, ids = make_oscillations(n_sequences=2, n_frames=40, random_state=0)
     model = ConditionalRBM(4, batch_size=1000, random_state=0)
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr("sklearn_crbm._base_layer.AUTO_UPDATES", 1200)
+        patch.setattr("sklearn_crbm.models._one_layer.AUTO_UPDATES", 1200)
         model.fit(X, sequence_ids=ids)
         early = ConditionalRBM(
             4,

@@ -13,7 +13,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 from scipy.special import expit
 
-from sklearn_crbm._gibbs import HiddenSampler, gibbs_frames
+from sklearn_crbm._engines._gibbs import HiddenSampler, gibbs_frames
 from sklearn_crbm.layers._base import logistic
 from sklearn_crbm.layers._crbm import CRBMFrames, CRBMLayer
 from sklearn_crbm.layers._parameters import MomentumUpdate

@@ -246,7 +246,7 @@ def test_start_values_are_the_released_codes():
 def test_learning_rates_per_group_and_momentum_are_the_released_codes():
     """A tenth of the rate for past->visible factors and R; the rest in full,
     past->hidden and style->factor weights included; momentum 0.9 from epoch 6."""
-    from sklearn_crbm._training import Schedule
+    from sklearn_crbm._engines._training import Schedule
     from sklearn_crbm.layers._factored import FactoredLayer
 
     for shared in (True, False):
@@ -262,7 +262,7 @@ def test_learning_rates_per_group_and_momentum_are_the_released_codes():
 def test_balanced_frames_repeat_each_style_to_the_most_frequents_count():
     """Each style repeated round(n_max / n) times, next to its frames; a frame's
     style is its largest label weight."""
-    from sklearn_crbm._factored import balanced_frames
+    from sklearn_crbm.models._factored import balanced_frames
 
     frames = np.array([2, 3, 4, 5, 7, 8, 9])
     weights = np.zeros((10, 3))
@@ -297,7 +297,7 @@ def test_styles_are_balanced_by_default():
 
 def _bounded_update(max_step, statistics):
     """One momentum step of a small layer, bounded; ``(before, after, update)``."""
-    from sklearn_crbm._training import StepBound
+    from sklearn_crbm._engines._training import StepBound
     from sklearn_crbm.layers._factored import FactoredLayer
     from sklearn_crbm.layers._parameters import MomentumUpdate
 
@@ -333,7 +333,7 @@ def test_step_bound_keeps_training_from_running_away(data_home):
     weights run away within a few epochs of momentum, unless bounded."""
     import sklearn
 
-    from sklearn_crbm._training import TrainingDivergedError
+    from sklearn_crbm._engines._training import TrainingDivergedError
     from sklearn_crbm.datasets import load_bandai_walks
     from sklearn_crbm.preprocessing import make_motion_preprocessor
 
@@ -353,7 +353,7 @@ def test_step_bound_keeps_training_from_running_away(data_home):
 
 
 def test_divergence_says_what_to_change():
-    from sklearn_crbm._training import Schedule, _divergence_message
+    from sklearn_crbm._engines._training import Schedule, _divergence_message
 
     schedule = Schedule.of(FactoredCRBM(learning_rate=0.3))
     message = _divergence_message(schedule, 7)

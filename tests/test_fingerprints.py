@@ -27,9 +27,9 @@ import numpy as np
 import pytest
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._stacked import StackedCRBM
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.impute import CRBMImputer
+from sklearn_crbm.models._stacked import StackedCRBM
 
 PATH = Path(__file__).parent / "data" / "fingerprints.json"
 

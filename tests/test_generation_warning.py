@@ -10,7 +10,9 @@ import sklearn
 
 import sklearn_crbm
 from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM, StackedCRBM
-from sklearn_crbm._base import (
+from sklearn_crbm.datasets import make_oscillations, make_walker
+from sklearn_crbm.exceptions import GenerationWarning, TrainingDivergedError
+from sklearn_crbm.metrics._liveliness import (
     BLOWN_DEVIATIONS,
     BLOWN_REACH,
     DEAD_FRACTION,
@@ -19,8 +21,6 @@ from sklearn_crbm._base import (
     lifeless_message,
     reference_amplitude,
 )
-from sklearn_crbm.datasets import make_oscillations, make_walker
-from sklearn_crbm.exceptions import GenerationWarning, TrainingDivergedError
 from sklearn_crbm.preprocessing import make_motion_pipeline
 
 

@@ -1,7 +1,7 @@
 """A new kind of layer is one class and its estimator, in this module alone.
 
 The layer below is written against the layer interface
-(:class:`~sklearn_crbm._layer.ConditionalLayer`), not derived from the CRBM
+(:class:`~sklearn_crbm.layers.ConditionalLayer`), not derived from the CRBM
 layer: Gaussian visibles of unit variance ``v``, binary hidden units ``h``,
 the past ``p`` (``order`` frames) and a real-valued per-frame context ``y``
 (control signals), with
@@ -26,7 +26,6 @@ from scipy.special import logsumexp
 from sklearn.frozen import FrozenEstimator
 from sklearn.utils._param_validation import Interval
 
-from sklearn_crbm._base_layer import BaseLayerModel
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.exceptions import GenerationWarning
 from sklearn_crbm.impute import CRBMImputer
@@ -37,6 +36,7 @@ from sklearn_crbm.layers import (
     ParameterGroup,
 )
 from sklearn_crbm.layers._parameters import small_normal
+from sklearn_crbm.models._one_layer import BaseLayerModel
 
 
 def _group(name, shape, decayed=True):

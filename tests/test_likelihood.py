@@ -15,7 +15,7 @@ from numpy.testing import assert_allclose
 from scipy.special import logsumexp
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._likelihood import (
+from sklearn_crbm._engines._likelihood import (
     annealing_schedule,
     exact_is_cheaper,
     log_partition_ais,

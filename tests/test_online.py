@@ -1,4 +1,4 @@
-"""The one on-line loop behind generation and fill-in (``sklearn_crbm._online``)."""
+"""The one on-line loop behind generation and fill-in (``sklearn_crbm._engines._online``)."""
 
 import pickle
 
@@ -8,9 +8,8 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from sklearn_crbm import ConditionalRBM, StackedCRBM
-from sklearn_crbm._base import FittedParameter
-from sklearn_crbm._gibbs import gibbs_frames
-from sklearn_crbm._online import (
+from sklearn_crbm._engines._gibbs import gibbs_frames
+from sklearn_crbm._engines._online import (
     TOP_LAYER,
     WHOLE_STACK,
     History,
@@ -19,6 +18,7 @@ from sklearn_crbm._online import (
 )
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.layers._crbm import CRBMLayer
+from sklearn_crbm.models._base import FittedParameter
 from sklearn_crbm.utils._sequences import check_sequence_ids
 
 X, IDS = make_oscillations(n_sequences=3, n_frames=30, random_state=0)

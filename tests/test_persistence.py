@@ -37,7 +37,6 @@ from sklearn.exceptions import InconsistentVersionWarning
 from sklearn.pipeline import Pipeline
 
 from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM
-from sklearn_crbm._stacked import StackedCRBM
 from sklearn_crbm.datasets import (
     load_cmu35,
     make_oscillations,
@@ -45,6 +44,7 @@ from sklearn_crbm.datasets import (
     make_walker,
 )
 from sklearn_crbm.impute import CRBMImputer, NearestNeighborImputer
+from sklearn_crbm.models._stacked import StackedCRBM
 from sklearn_crbm.preprocessing import (
     ExpMapEncoder,
     RootRelativeEncoder,

@@ -12,10 +12,10 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
 from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM
-from sklearn_crbm import _base as base_module
-from sklearn_crbm._stacked import StackedCRBM
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.model_selection import make_prediction_scorer
+from sklearn_crbm.models import _base as base_module
+from sklearn_crbm.models._stacked import StackedCRBM
 
 
 def small_stack(**params):

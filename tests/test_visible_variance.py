@@ -18,7 +18,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from scipy.special import expit, logsumexp
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._gibbs import HiddenSampler
+from sklearn_crbm._engines._gibbs import HiddenSampler
 from sklearn_crbm.datasets import make_oscillations
 from sklearn_crbm.layers._crbm import CRBMFrames, CRBMLayer
 

@@ -252,7 +252,7 @@ def skip_fitted_parameters(app, what, name, obj, skip, options):
     packed parameters; listing them as members would repeat each one with
     the descriptor's own docstring.
     """
-    from sklearn_crbm._base import FittedParameter
+    from sklearn_crbm.models._base import FittedParameter
 
     return True if isinstance(obj, FittedParameter) else None
 

@@ -12,11 +12,11 @@ import warnings
 import numpy as np
 from sklearn.impute import KNNImputer
 
-from .._base import DEAD_FRACTION, generated_liveliness
 from ..datasets import write_amc, write_bvh
 from ..exceptions import GenerationWarning
 from ..impute import AutoregressiveImputer, CRBMImputer, NearestNeighborImputer
 from ..metrics import judge_generated_motion
+from ..metrics._liveliness import DEAD_FRACTION, generated_liveliness
 from ..model_selection import compare_imputers, make_fillin_cases
 from ..preprocessing import make_motion_preprocessor
 from ..utils import random_windows

@@ -17,9 +17,6 @@ import numpy as np
 import sklearn
 from sklearn.utils import Bunch
 
-from .._base import DEAD_FRACTION, generated_liveliness, lifeless_message
-from .._crbm import ConditionalRBM
-from .._factored import FactoredCRBM
 from ..datasets import (
     fetch_bandai_walks,
     fetch_cmu35,
@@ -32,6 +29,13 @@ from ..datasets import (
     resample_frames,
 )
 from ..exceptions import GenerationWarning
+from ..metrics._liveliness import (
+    DEAD_FRACTION,
+    generated_liveliness,
+    lifeless_message,
+)
+from ..models._crbm import ConditionalRBM
+from ..models._factored import FactoredCRBM
 from ..preprocessing import MotionContext, MotionPipeline, make_motion_pipeline
 from ._demo import liveliness_text, save_gif
 from ._demo import run_demo as _run_demo

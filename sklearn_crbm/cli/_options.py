@@ -4,8 +4,8 @@ import argparse
 import math
 from pathlib import Path
 
-from .._crbm import ConditionalRBM
-from .._factored import FactoredCRBM
+from ..models._crbm import ConditionalRBM
+from ..models._factored import FactoredCRBM
 from ..plotting._skeleton import VIEWS
 
 __all__ = ["COMMANDS", "OUTPUT"]

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 from sklearn.utils import Bunch
 
-from ..utils._sequences import remember_sequences
+from ..utils._sequences import remember_sequences, stack_sequences
 from ._bandai import BANDAI_FOLDER
 from ._folders import read_bvh_folder
 from ._frame_rate import kept_frames
@@ -246,9 +246,7 @@ def load_mit_walk(data_home=None):
         motion[kept_frames(len(motion), MIT_RECORDING_RATE, FRAME_RATE)]
         for motion in motions
     ]
-    data = np.concatenate(sequences)
-    sequence_ids = np.repeat(np.arange(len(sequences)), [len(s) for s in sequences])
-    remember_sequences(data, sequence_ids)
+    data, sequence_ids = stack_sequences(sequences)
     return Bunch(
         data=data,
         sequence_ids=sequence_ids,

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 from sklearn.utils import Bunch
 
-from ..utils._sequences import remember_sequences
+from ..utils._sequences import stack_sequences
 from ._acclaim import read_amc
 from ._agreement import check_agreement
 from ._bvh import read_bvh
@@ -307,9 +307,7 @@ def _long_format(folder, sequences, frame_rate, kind):
         path.relative_to(folder).with_suffix("").as_posix()
         for path, _, _, _ in sequences
     ]
-    data = np.concatenate(kept)
-    sequence_ids = np.repeat(np.arange(len(kept)), [len(d) for d in kept])
-    remember_sequences(data, sequence_ids)
+    data, sequence_ids = stack_sequences(kept)
     return Bunch(
         data=data,
         sequence_ids=sequence_ids,

@@ -9,15 +9,15 @@ from sklearn.utils import check_random_state, get_tags
 from sklearn.utils._param_validation import HasMethods, Interval, StrOptions
 from sklearn.utils.validation import _is_fitted, _num_samples, check_is_fitted
 
-from .._base import check_context, check_count
-from .._crbm import ConditionalRBM
-from .._online import WHOLE_STACK, Observed, collect_fills, run_online
+from .._engines._online import WHOLE_STACK, Observed, collect_fills, run_online
+from ..models._crbm import ConditionalRBM
 from ..utils._array_api import array_ops, array_random, copy_array
 from ..utils._fitting import unfitted_on_error
 from ..utils._parallel import BLOCK_SEQUENCES, map_sequence_blocks
 from ..utils._random import rng_from
 from ..utils._sequences import Sequences, check_sequence_ids
 from ..utils._threads import chain_rows, limit_blas_threads
+from ..utils._validation import check_context, check_count
 from ._base import BaseMotionImputer, check_same_place
 from ._base import to_numpy as _to_numpy
 
@@ -414,7 +414,7 @@ n_classes), default=None
     def _fill(self, X, mask, sequences, context, n_draws, rng):
         """``n_draws`` on-line fills, all sequences and draws advancing together.
 
-        Every draw runs ``n_particles`` chains (:func:`~sklearn_crbm._online.
+        Every draw runs ``n_particles`` chains (:func:`~sklearn_crbm._engines._online.
         run_online` with the observed channels clamped); a draw's fill of a
         frame is the mean of its particles'.  ``context`` is the model's
         ``(frame_context, hypotheses)``.  Returns an array of shape

@@ -11,7 +11,7 @@ the likelihood, the imputers) talks to layers only through this
 interface, so a new kind of layer is one new class (and its estimator).
 
 The context reaches a layer from one keyword of every estimator method
-that depends on time (:class:`~sklearn_crbm._base.BaseCRBM`):
+that depends on time (:class:`~sklearn_crbm.models._base.BaseCRBM`):
 ``fit(X, y=None, *, sequence_ids=None, context=None)`` (and
 ``partial_fit``, ``fit_transform``, ``score`` alike), ``transform``,
 ``predict_next``, ``score_samples`` and ``estimate_log_likelihood`` with

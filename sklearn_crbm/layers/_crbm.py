@@ -32,7 +32,7 @@ from numbers import Integral
 import numpy as np
 from sklearn.utils._param_validation import Interval
 
-from .._gibbs import HiddenSampler
+from .._engines._gibbs import HiddenSampler
 from ..utils._array_api import array_ops, same_memory
 from ._base import ConditionalLayer, FrameRBMs, TrainingWorkspace
 from ._parameters import ParameterGroup, small_normal

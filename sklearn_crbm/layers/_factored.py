@@ -24,7 +24,7 @@ import functools
 
 import numpy as np
 
-from .._gibbs import HiddenSampler
+from .._engines._gibbs import HiddenSampler
 from ..utils._random import sample_bernoulli
 from ._base import (
     GAUSSIAN,

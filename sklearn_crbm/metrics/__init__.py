@@ -8,18 +8,16 @@ move like it.
 
 from ._fillin import fillin_angle_rmse, fillin_error
 from ._generation import (
-    foot_skating,
     forward_speed,
     gait_statistics,
-    jitter,
-    liveliness,
-    most_moving_channels,
     motion_amplitude,
     nearest_style,
     spectral_similarity,
     step_frequency,
 )
 from ._judge import judge_generated_motion
+from ._liveliness import liveliness, most_moving_channels
+from ._positions import foot_skating, jitter
 from ._style import StyleJudge
 
 __all__ = [

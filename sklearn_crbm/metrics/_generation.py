@@ -8,7 +8,7 @@ sequence.  Channels are chosen by name (``feature_names``, or the columns of
 a DataFrame) or by column index.
 """
 
-from numbers import Integral, Real
+from numbers import Integral
 
 import numpy as np
 from scipy.signal import welch
@@ -16,14 +16,11 @@ from sklearn.utils import check_array
 
 from ..datasets import bone_columns
 from ..utils._sequences import check_sequence_ids
+from ..utils._validation import check_frame_rate
 
 __all__ = [
-    "foot_skating",
     "forward_speed",
     "gait_statistics",
-    "jitter",
-    "liveliness",
-    "most_moving_channels",
     "motion_amplitude",
     "nearest_style",
     "spectral_similarity",
@@ -137,14 +134,6 @@ def _segments(X, sequences, columns, last_frames=None):
         if last_frames is not None:
             start = max(start, stop - last_frames)
         yield X[start:stop, columns]
-
-
-def _check_frame_rate(frame_rate):
-    if isinstance(frame_rate, bool) or not isinstance(frame_rate, Real):
-        raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
-    if not frame_rate > 0:
-        raise ValueError(f"frame_rate must be a positive number, got {frame_rate!r}.")
-    return float(frame_rate)
 
 
 def forward_speed(
@@ -314,7 +303,7 @@ def step_frequency(
     >>> step_frequency(np.vstack([walk, jog]), sequence_ids=ids).round(1)
     array([1. , 1.4])
     """
-    frame_rate = _check_frame_rate(frame_rate)
+    frame_rate = check_frame_rate(frame_rate)
     X, sequences, names = _check_motion(X, sequence_ids, feature_names)
     columns = _columns(features, names, X.shape[1])
     frequencies = []
@@ -608,265 +597,3 @@ def nearest_style(features, reference_features, reference_styles):
     ]
     labels[~finite] = None
     return labels
-
-
-def _within_sequence_std(X, sequences, columns, last_frames=None):
-    """Standard deviation of every chosen column within every sequence."""
-    return np.array(
-        [
-            segment.std(axis=0)
-            for segment in _segments(X, sequences, columns, last_frames)
-        ]
-    ).reshape(-1, len(columns))
-
-
-def most_moving_channels(
-    X, *, sequence_ids=None, n_channels=12, features=None, feature_names=None
-):
-    """The channels that move most within the sequences of ``X``, most first.
-
-    Channels are ranked by their standard deviation within each sequence,
-    averaged over the sequences (weighted by their frames): what moves
-    during a take, not what differs between takes (a posture held
-    throughout one take).
-
-    Parameters
-    ----------
-    X : array-like of shape (n_frames, n_features)
-        Motion, all sequences stacked in long format.
-    sequence_ids : array-like of shape (n_frames,), default=None
-        Sequence id of every frame; ``None`` means one sequence.
-    n_channels : int, default=12
-        How many channels (fewer if fewer are chosen from).
-    features : list of str or int, default=None
-        The channels to choose from, by name or column index (for example
-        the joint angles alone, in one unit); ``None`` means all.
-    feature_names : array-like of str, default=None
-        Names of the columns of ``X``; default the columns of a DataFrame.
-
-    Returns
-    -------
-    columns : ndarray of int of shape (n_channels,)
-        Column indices into ``X``, the most moving first.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from sklearn_crbm.metrics import most_moving_channels
-    >>> t = np.arange(100)
-    >>> X = np.column_stack([np.sin(t / 5), 3 * np.sin(t / 5), np.ones(100)])
-    >>> most_moving_channels(X, n_channels=2)
-    array([1, 0])
-    """
-    if isinstance(n_channels, bool) or not isinstance(n_channels, Integral):
-        raise ValueError(f"n_channels must be a positive integer, got {n_channels!r}.")
-    if n_channels < 1:
-        raise ValueError(f"n_channels must be a positive integer, got {n_channels!r}.")
-    X, sequences, names = _check_motion(X, sequence_ids, feature_names)
-    columns = _columns(features, names, X.shape[1])
-    spread = np.average(
-        _within_sequence_std(X, sequences, columns), axis=0, weights=sequences.lengths
-    )
-    order = np.argsort(-spread, kind="stable")
-    return columns[order[:n_channels]]
-
-
-def liveliness(
-    X,
-    X_reference,
-    *,
-    sequence_ids=None,
-    reference_sequence_ids=None,
-    n_channels=12,
-    features=None,
-    feature_names=None,
-    last_frames=None,
-):
-    """How much each sequence moves, as a fraction of how much real motion does.
-
-    The ``n_channels`` channels that move most in the reference motion
-    (:func:`most_moving_channels`) are the ones judged.  A sequence's
-    liveliness is the mean, over those channels, of its standard deviation
-    over its frames (only the last ``last_frames``, where given), divided
-    by the same mean for the reference sequences (their within-sequence
-    standard deviations, averaged weighted by frames).  1 is as lively as
-    the reference; generated motion that dies out into a pose goes to 0.
-    Compare in units where the channels are alike (for example the joint
-    angles of the exponential maps, in radians, before standard scaling).
-
-    Parameters
-    ----------
-    X : array-like of shape (n_frames, n_features)
-        The motion to judge (for example generated), sequences stacked.
-    X_reference : array-like of shape (n_reference_frames, n_features)
-        Real motion in the same representation (for example the training
-        takes).
-    sequence_ids : array-like of shape (n_frames,), default=None
-        Sequence id of every frame of ``X``; ``None`` means one sequence.
-    reference_sequence_ids : array-like of shape (n_reference_frames,), default=None
-        Sequence id of every frame of ``X_reference``.
-    n_channels : int, default=12
-        How many of the most moving channels are judged.
-    features : list of str or int, default=None
-        The channels to choose from, by name or column index; ``None``
-        means all.
-    feature_names : array-like of str, default=None
-        Names of the columns of both arrays; default the columns of ``X``
-        if it is a DataFrame.
-    last_frames : int, default=None
-        Judge only the last ``last_frames`` frames of each sequence of ``X``.
-
-    Returns
-    -------
-    liveliness : ndarray of shape (n_sequences,)
-        Non-negative; 1 is as lively as the reference.
-
-    See Also
-    --------
-    motion_amplitude : The amplitude of chosen channels, in their units.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from sklearn_crbm.metrics import liveliness
-    >>> t = np.arange(200)
-    >>> real = np.column_stack([np.sin(t / 5), np.cos(t / 5)])
-    >>> fading = real * np.exp(-t / 50)[:, None]
-    >>> liveliness(np.vstack([real, fading]), real, n_channels=2,
-    ...            sequence_ids=np.repeat([0, 1], 200), last_frames=100).round(2)
-    array([1.  , 0.07])
-    """
-    X, sequences, names, X_reference, reference = _check_motion_pair(
-        X, X_reference, sequence_ids, reference_sequence_ids, feature_names
-    )
-    columns = most_moving_channels(
-        X_reference,
-        sequence_ids=reference.per_frame_ids(),
-        n_channels=n_channels,
-        features=_columns(features, names, X.shape[1]),
-    )
-    real = np.average(
-        _within_sequence_std(X_reference, reference, columns),
-        axis=0,
-        weights=reference.lengths,
-    ).mean()
-    if not real > 0:
-        raise ValueError("The reference motion does not move in the chosen channels.")
-    return _within_sequence_std(X, sequences, columns, last_frames).mean(axis=1) / real
-
-
-def _check_positions(positions, sequence_ids):
-    """Joint positions as (n_frames, n_joints, 3), and the sequences."""
-    positions = np.asarray(positions, dtype=np.float64)
-    if positions.ndim == 2 and positions.shape[1] % 3 == 0:
-        positions = positions.reshape(positions.shape[0], -1, 3)
-    if positions.ndim != 3 or positions.shape[2] != 3:
-        raise ValueError(
-            "positions must have shape (n_frames, n_joints, 3) (what "
-            "Skeleton.forward_kinematics returns) or (n_frames, 3 * n_joints); "
-            f"got shape {positions.shape}."
-        )
-    return positions, check_sequence_ids(sequence_ids, positions.shape[0])
-
-
-def jitter(positions, *, sequence_ids=None):
-    """Mean size of the third difference of joint positions in each sequence.
-
-    The norm of ``p[t] - 3 p[t-1] + 3 p[t-2] - p[t-3]`` (the change of
-    acceleration from frame to frame, in length units) of every joint,
-    averaged over the joints and frames of each sequence.  Smooth motion
-    has a small jerk; generated motion that shakes from frame to frame has
-    a larger one than real motion of the same kind.
-
-    Parameters
-    ----------
-    positions : array-like of shape (n_frames, n_joints, 3)
-        Joint positions, all sequences stacked (for example
-        :meth:`~sklearn_crbm.datasets.Skeleton.forward_kinematics` of raw
-        channels); ``(n_frames, 3 * n_joints)`` is accepted too.
-    sequence_ids : array-like of shape (n_frames,), default=None
-        Sequence id of every frame; ``None`` means one sequence.
-
-    Returns
-    -------
-    jitter : ndarray of shape (n_sequences,)
-        Length units per frame cubed; ``nan`` for a sequence of fewer than
-        4 frames.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from sklearn_crbm.metrics import jitter
-    >>> t = np.arange(10.0)
-    >>> smooth = np.column_stack([t ** 2, 0 * t, 0 * t])[:, None, :]
-    >>> shaky = smooth.copy()
-    >>> shaky[:, 0, 1] = [0.0, 1.0] * 5  # up and down every other frame
-    >>> jitter(np.concatenate([smooth, shaky]), sequence_ids=np.repeat([0, 1], 10))
-    array([0., 4.])
-    """
-    positions, sequences = _check_positions(positions, sequence_ids)
-    values = []
-    for start, stop in zip(sequences.starts, sequences.stops, strict=True):
-        third = np.diff(positions[start:stop], n=3, axis=0)
-        values.append(np.linalg.norm(third, axis=2).mean() if len(third) else np.nan)
-    return np.asarray(values)
-
-
-def foot_skating(positions, *, feet, sequence_ids=None, up_axis=1, contact_height=3.0):
-    """Horizontal speed of the feet while they touch the ground, per sequence.
-
-    A foot is taken to touch the ground in the frames where it is within
-    ``contact_height`` of its lowest height in the sequence; its horizontal
-    displacement from each such frame to the next is averaged over those
-    frames and over the feet.  A real foot stands still while it carries
-    the body; generated walks whose feet slide along the ground score
-    higher than real ones.
-
-    Parameters
-    ----------
-    positions : array-like of shape (n_frames, n_joints, 3)
-        Joint positions, all sequences stacked (for example
-        :meth:`~sklearn_crbm.datasets.Skeleton.forward_kinematics` of raw
-        channels).
-    feet : list of int
-        The joints (indices into the second axis) of the feet, for example
-        the toes or ankles of both legs.
-    sequence_ids : array-like of shape (n_frames,), default=None
-        Sequence id of every frame; ``None`` means one sequence.
-    up_axis : int, default=1
-        The vertical axis of the positions (0, 1 or 2; 1 for Y up).
-    contact_height : float, default=3.0
-        How far above its lowest point a foot still touches the ground, in
-        the length units of ``positions`` (3 cm for data in centimetres).
-
-    Returns
-    -------
-    skating : ndarray of shape (n_sequences,)
-        Length units per frame; ``nan`` for a sequence of one frame.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from sklearn_crbm.metrics import foot_skating
-    >>> height = np.array([0.0, 0.0, 10.0, 10.0, 0.0, 0.0])
-    >>> forward = np.array([0.0, 0.0, 5.0, 10.0, 15.0, 17.0])
-    >>> foot = np.column_stack([forward, height, np.zeros(6)])[:, None, :]
-    >>> foot_skating(foot, feet=[0])  # moves 0, 5 (lifting off) and 2 while down
-    array([2.33333333])
-    """
-    positions, sequences = _check_positions(positions, sequence_ids)
-    if up_axis not in (0, 1, 2):
-        raise ValueError(f"up_axis must be 0, 1 or 2, got {up_axis!r}.")
-    feet = np.atleast_1d(np.asarray(feet, dtype=np.intp))
-    horizontal = [axis for axis in range(3) if axis != up_axis]
-    values = []
-    for start, stop in zip(sequences.starts, sequences.stops, strict=True):
-        foot = positions[start:stop][:, feet, :]
-        if len(foot) < 2:
-            values.append(np.nan)
-            continue
-        height = foot[..., up_axis]
-        touching = (height - height.min(axis=0)) <= contact_height
-        step = np.linalg.norm(np.diff(foot[..., horizontal], axis=0), axis=2)
-        values.append(float(step[touching[:-1]].mean()))
-    return np.asarray(values)

@@ -193,7 +193,7 @@ class StyleJudge(ClassifierMixin, BaseEstimator):
             StandardScaler(), LogisticRegression(C=self.C, max_iter=self.max_iter)
         ).fit(self._describe(X, starts), window_codes)
         self.n_iter_ = int(self.classifier_[-1].n_iter_.max())
-        amplitude, frequency = self._liveliness(X, starts)
+        amplitude, frequency = self._amplitude_and_frequency(X, starts)
         self.reference_amplitude_ = np.array(
             [np.median(amplitude[window_codes == k]) for k in range(len(self.classes_))]
         )
@@ -365,7 +365,7 @@ or (n_sequences, n_classes)
             requested = predicted
         else:
             requested = self._style_codes(style, X.shape[0])[starts + self.window - 1]
-        amplitude, frequency = self._liveliness(X, starts)
+        amplitude, frequency = self._amplitude_and_frequency(X, starts)
         with np.errstate(divide="ignore", invalid="ignore"):
             amplitude_ratio = amplitude / self.reference_amplitude_[requested]
             frequency_ratio = frequency / self.reference_frequency_[requested]
@@ -452,7 +452,7 @@ or (n_sequences, n_classes)
                 "sklearn_crbm.datasets.bone_columns finds them by bone name."
             )
 
-    def _liveliness(self, X, starts):
+    def _amplitude_and_frequency(self, X, starts):
         """Leg amplitude and step frequency (cycles per frame) of every window."""
         legs = slice(None) if self.legs is None else np.asarray(self.legs)
         frames = (starts[:, None] + np.arange(self.window)).ravel()

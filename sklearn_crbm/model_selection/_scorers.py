@@ -434,13 +434,9 @@ class _PredictionScorer(_SequenceScorer):
             )
         X = check_array(X, dtype=np.float64)
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
-        frames = sequences.valid_frames(model.history_length)
-        if len(frames) == 0:
-            raise ValueError(
-                f"The prediction scorer needs frames with {model.history_length} "
-                "past frames in their own sequence; every sequence given is "
-                "shorter. Pass longer sequences."
-            )
+        frames = sequences.frames_with_past(
+            model.history_length, "The prediction scorer"
+        )
         predicted = model.predict_next(X, sequence_ids=sequence_ids)
         score = self._score_func(X[frames], np.asarray(predicted)[frames])
         return self._sign * float(score)

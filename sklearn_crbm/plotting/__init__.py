@@ -18,19 +18,18 @@ matplotlib is imported only when a function is called.
   frames of a sequence (a style judge's verdict on a transition).
 """
 
+from ._animation import (
+    animate_motion,
+    animate_motions,
+    motion_to_html,
+    save_animation,
+)
 from ._figures import (
     plot_filled_channels,
     plot_hidden_activations,
     plot_style_probabilities,
 )
-from ._skeleton import (
-    animate_motion,
-    animate_motions,
-    motion_to_html,
-    plot_motion_strip,
-    plot_skeleton,
-    save_animation,
-)
+from ._skeleton import plot_motion_strip, plot_skeleton
 
 __all__ = [
     "animate_motion",

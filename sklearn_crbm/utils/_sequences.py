@@ -137,6 +137,19 @@ def _cut_sequences(row_ids, all_ids):
     ]
 
 
+def stack_sequences(sequences):
+    """Sequences of frames in long format: ``(data, sequence_ids)``.
+
+    The frames of every sequence, one after the other, and the sequence
+    number of every frame (0 for the first sequence); the loader's ids are
+    remembered for :func:`warn_if_sequences_unmarked`.
+    """
+    data = np.concatenate(sequences)
+    sequence_ids = np.repeat(np.arange(len(sequences)), [len(s) for s in sequences])
+    remember_sequences(data, sequence_ids)
+    return data, sequence_ids
+
+
 def warn_if_sequences_unmarked(X, sequence_ids, method, stacklevel=3):
     """Warn when ``X`` holds frames of several of a loader's sequences and
     ``sequence_ids`` is None (every frame would count as one sequence), or
@@ -213,6 +226,16 @@ class Sequences:
         first = self.starts + order
         counts = np.maximum(self.stops - first, 0)
         return _ranges(first, counts)
+
+    def frames_with_past(self, order, needed_by):
+        """:meth:`valid_frames`; a ValueError naming ``needed_by`` if there are none."""
+        frames = self.valid_frames(order)
+        if len(frames) == 0:
+            raise ValueError(
+                f"{needed_by} needs frames with {order} past frames in their own "
+                "sequence; every sequence given is shorter. Pass longer sequences."
+            )
+        return frames
 
     def per_frame_ids(self):
         """Sequence id of every frame."""

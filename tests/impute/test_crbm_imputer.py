@@ -320,7 +320,7 @@ def test_sample_rejects_bad_counts(fitted, test_data):
 
 @pytest.mark.parametrize("n_particles", [1, 3])
 def test_stacked_estimator(test_data, n_particles):
-    from sklearn_crbm._stacked import StackedCRBM
+    from sklearn_crbm.models._stacked import StackedCRBM
 
     X_train, ids = make_oscillations(
         n_sequences=4, n_frames=30, n_features=5, random_state=0
@@ -345,7 +345,7 @@ def test_stacked_estimator(test_data, n_particles):
 
 
 def test_observed_log_likelihood_hand_computed():
-    from sklearn_crbm._gibbs import observed_log_likelihood
+    from sklearn_crbm._engines._gibbs import observed_log_likelihood
     from sklearn_crbm.layers._crbm import CRBMLayer
 
     def frame_rbms(n_features, visible_type, n_frames):
@@ -372,7 +372,7 @@ def test_observed_log_likelihood_hand_computed():
 
 
 def test_stacked_gibbs_with_one_layer_is_gibbs_frames():
-    from sklearn_crbm._gibbs import gibbs_frames, stacked_gibbs_frames
+    from sklearn_crbm._engines._gibbs import gibbs_frames, stacked_gibbs_frames
     from sklearn_crbm.layers._crbm import CRBMLayer
 
     rng = np.random.default_rng(0)

@@ -18,8 +18,8 @@ from sklearn.pipeline import Pipeline
 from threadpoolctl import threadpool_limits
 
 from sklearn_crbm import ConditionalRBM
-from sklearn_crbm._stacked import StackedCRBM
 from sklearn_crbm.model_selection import make_prediction_scorer
+from sklearn_crbm.models._stacked import StackedCRBM
 from sklearn_crbm.preprocessing import make_motion_preprocessor
 
 CV = GroupKFold(n_splits=3)

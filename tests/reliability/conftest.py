@@ -26,7 +26,7 @@ from sklearn_crbm.preprocessing import (
 # only in its private module.
 StackedCRBM = (
     getattr(sklearn_crbm, "StackedCRBM", None)
-    or importlib.import_module("sklearn_crbm._stacked").StackedCRBM
+    or importlib.import_module("sklearn_crbm.models._stacked").StackedCRBM
 )
 
 N_FEATURES = 4

@@ -25,15 +25,15 @@ from numbers import Real
 
 import numpy as np
 
+from ..layers._base import sequence_hidden_probabilities
+from ..utils._array_api import array_ops, copy_array, to_numpy
+from ..utils._sequences import Sequences
 from ._gibbs import (
     gibbs_frames,
-    observed_log_likelihood,
     stacked_gibbs_frames,
     stacked_prediction,
 )
-from .layers._base import sequence_hidden_probabilities
-from .utils._array_api import array_ops, copy_array, to_numpy
-from .utils._sequences import Sequences
+from ._resampling import PREDICTION_STEPS, _ancestors, _take_chains
 
 __all__ = [
     "TOP_LAYER",
@@ -53,15 +53,13 @@ given its own past).  Every layer's past is the values that pass produced.
 Nothing can be clamped: the data sit at the bottom."""
 WHOLE_STACK = "whole_stack"
 """Every Gibbs iteration goes up the stack and down again
-(:func:`~sklearn_crbm._gibbs.stacked_gibbs_frames`), so the state of the
+(:func:`~sklearn_crbm._engines._gibbs.stacked_gibbs_frames`), so the state of the
 chain is the frame itself and its observed channels can be clamped.  The
 upper layers' past is the final frame passed up (hidden probabilities)."""
 
 # Rounds of "fill, then use the fill as its own past" for the first frame of a
 # sequence in fill-in, which has no past frames.
 FIRST_FRAME_ROUNDS = 3
-# Mean-field iterations of the one-step prediction that weights particles.
-PREDICTION_STEPS = 10
 
 
 class History:
@@ -239,7 +237,7 @@ class Offsets:
     typical values (a slow posture channel towards the training posture);
     while a channel is observed, its one-step residual ``r_t = x_t -
     x_hat_t`` (``x_hat_t`` the chain's mean-field prediction of the frame
-    from its past, :func:`~sklearn_crbm._gibbs.stacked_prediction`) shows
+    from its past, :func:`~sklearn_crbm._engines._gibbs.stacked_prediction`) shows
     that error.  The correction of a missing entry is the posterior mean of
     a constant offset ``d`` behind the residuals, ``r_t = d + noise``, with a
     prior worth ``shrinkage`` frames of zero residual: ``sum(r) / (n +
@@ -521,7 +519,7 @@ def _fill(
         # evidence; otherwise only frames to draw tell particles apart
         weighed = drawn if chain_context is None else lengths > step
         if n_particles > 1 and weighed.any():
-            some = _Some(ops, weighed, n_chains)
+            some = _ActiveSequences(ops, weighed, n_chains)
             chains = _ancestors(
                 some.stack(history.frame_rbms(context)),
                 some.frames(frames),
@@ -536,7 +534,7 @@ def _fill(
         stack = history.frame_rbms(context)
         prediction = None
         if offsets is not None or amplify:
-            alive = _Some(ops, lengths > step, n_chains)
+            alive = _ActiveSequences(ops, lengths > step, n_chains)
             prediction = stacked_prediction(alive.stack(stack), PREDICTION_STEPS)
             prediction = ops.reshape(prediction, (n_chains, -1, shape[-1]))
             prediction = alive.put_back(prediction, current)
@@ -551,7 +549,7 @@ def _fill(
                 start = start + start_jitter * rng.standard_normal(
                     start.shape, start.dtype
                 )
-            some = _Some(ops, drawn, n_chains)
+            some = _ActiveSequences(ops, drawn, n_chains)
             new = draw(some.take(start), some.stack(stack), some.take(clamp))[0]
             current = some.put_back(new, current)
             if amplify:
@@ -562,7 +560,7 @@ def _fill(
         history.push([current], stack)
 
 
-class _Some:
+class _ActiveSequences:
     """The sequences of a step that need work: gathered, worked on, put back.
 
     A block of sequences of different lengths, or with frames to fill at
@@ -607,56 +605,6 @@ class _Some:
             return values
         ops = self._ops
         return ops.take(ops.concatenate((values, others), axis=1), self._where, axis=1)
-
-
-def _ancestors(stack, frames, observed, n_particles, rng):
-    """Resample each group of particles by how well they explain the observed data.
-
-    A particle's weight is the likelihood of the frame's observed channels
-    under its own one-step prediction from ``stack``, its frame RBMs
-    (:func:`~sklearn_crbm._gibbs.observed_log_likelihood`); each group is
-    resampled (systematic resampling).  Returns the ancestors, of shape
-    ``(n_chains, n_sequences)``, as :meth:`History.reorder` takes them.
-    """
-    ops = stack[0].ops
-    n_sequences, n_features = frames.shape
-    n_chains = stack[0].n_frames // n_sequences
-    n_groups = n_chains // n_particles
-    prediction = stacked_prediction(stack, PREDICTION_STEPS)
-    log_weights = observed_log_likelihood(
-        stack[0],
-        prediction,
-        ops.reshape(
-            ops.broadcast_to(frames, (n_chains, *frames.shape)), (-1, n_features)
-        ),
-        ops.reshape(
-            ops.broadcast_to(observed, (n_chains, *observed.shape)), (-1, n_features)
-        ),
-    )
-    log_weights = ops.reshape(log_weights, (n_groups, n_particles, n_sequences))
-    log_weights = log_weights - ops.max(log_weights, axis=1, keepdims=True)
-    cumulative = ops.cumsum(ops.exp(log_weights), axis=1)
-    cumulative = cumulative / cumulative[:, -1:, ...]
-    positions = (
-        rng.random((n_groups, 1, n_sequences))
-        + ops.arange(n_particles, dtype=ops.float64)[:, None]
-    ) / n_particles
-    # ancestor of particle i: how many cumulative weights lie below position i
-    below = cumulative[:, None, :, :] < positions[:, :, None, :]
-    ancestors = ops.sum(ops.astype(below, ops.int64), axis=2)
-    ancestors = ops.minimum(ancestors, n_particles - 1)
-    chains = (
-        ancestors + (ops.arange(n_groups, dtype=ops.int64) * n_particles)[:, None, None]
-    )
-    return ops.reshape(chains, (n_chains, n_sequences))
-
-
-def _take_chains(ops, array, chains):
-    """``array[chains[i, s], s]`` for every chain ``i`` and sequence ``s``."""
-    n_chains, n_sequences = chains.shape
-    flat = ops.reshape(array, (n_chains * n_sequences, -1))
-    index = chains * n_sequences + ops.arange(n_sequences, dtype=ops.int64)
-    return ops.reshape(ops.take(flat, ops.reshape(index, (-1,)), axis=0), array.shape)
 
 
 def _amplifies(gain):

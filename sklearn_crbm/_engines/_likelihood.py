@@ -50,8 +50,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .layers._base import clipped_logit, draw_bernoulli, logistic
-from .utils._array_api import array_ops, copy_array
+from ..layers._base import clipped_logit, draw_bernoulli, logistic
+from ..utils._array_api import array_ops, copy_array
 
 # Hidden configurations summed per block by the exact enumeration.
 _EXACT_BLOCK = 4096

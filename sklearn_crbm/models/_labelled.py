@@ -4,15 +4,11 @@ from numbers import Integral, Real
 
 from sklearn.utils._param_validation import Interval, StrOptions
 
+from ..layers._crbm import ORDER_CONSTRAINTS, CRBMLayer, hidden_order_of
 from ._base import FittedParameter
-from ._style_model import BaseStyleModel
-from .layers._crbm import ORDER_CONSTRAINTS, CRBMLayer, hidden_order_of
+from ._style import BaseStyleModel
 
 __all__ = ["LabelledCRBM"]
-
-# The layer of a LabelledCRBM pickled in format 1 before contexts were
-# real-valued: a CRBM layer whose context is the label weights.
-LabelledLayer = CRBMLayer
 
 
 class LabelledCRBM(BaseStyleModel):
@@ -166,20 +162,24 @@ class LabelledCRBM(BaseStyleModel):
         random_state=None,
         verbose=0,
     ):
-        self.n_components = n_components
-        self.order = order
+        super().__init__(
+            n_components,
+            order=order,
+            learning_rate=learning_rate,
+            momentum=momentum,
+            momentum_delay=momentum_delay,
+            weight_decay=weight_decay,
+            cd_steps=cd_steps,
+            batch_size=batch_size,
+            batching=batching,
+            history_noise=history_noise,
+            history_noise_fraction=history_noise_fraction,
+            average_fraction=average_fraction,
+            n_iter=n_iter,
+            random_state=random_state,
+            verbose=verbose,
+        )
         self.hidden_order = hidden_order
-        self.learning_rate = learning_rate
-        self.momentum = momentum
-        self.momentum_delay = momentum_delay
-        self.weight_decay = weight_decay
-        self.cd_steps = cd_steps
-        self.batch_size = batch_size
-        self.batching = batching
-        self.history_noise = history_noise
-        self.history_noise_fraction = history_noise_fraction
-        self.average_fraction = average_fraction
-        self.n_iter = n_iter
         self.n_gibbs = n_gibbs
         self.priors = priors
         self.ais_steps = ais_steps
@@ -189,8 +189,6 @@ class LabelledCRBM(BaseStyleModel):
         self.n_iter_no_change = n_iter_no_change
         self.validation_interval = validation_interval
         self.tol = tol
-        self.random_state = random_state
-        self.verbose = verbose
 
     def _new_layer(self, n_features, n_context, dtype):
         return CRBMLayer(

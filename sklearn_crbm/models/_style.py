@@ -4,7 +4,7 @@ A style model fitted on labels takes every frame's label weights ``y``
 (one-hot for a labelled frame, any non-negative weights that sum to 1 for a
 blend) as its context.  :class:`BaseStyleModel` turns labels into those
 weights (``y`` in ``fit`` and ``score``, ``style`` in the other methods of
-:class:`~sklearn_crbm._base.BaseCRBM`), names the style of a sequence by
+:class:`~sklearn_crbm.models._base.BaseCRBM`), names the style of a sequence by
 Bayes' rule (``classes_``, ``predict``, ``predict_proba``), infers the
 context of frames given none from each sequence's posterior, and scores
 them under the mixture of styles, each weighted by its posterior given the
@@ -22,10 +22,10 @@ from sklearn.base import clone
 from sklearn.utils._array_api import _estimator_with_converted_arrays
 from sklearn.utils.validation import check_is_fitted
 
-from ._base_layer import BaseLayerModel
-from .utils._array_api import array_ops, to_numpy
-from .utils._random import rng_from
-from .utils._threads import frame_rows, limit_blas_threads
+from ..utils._array_api import array_ops, to_numpy
+from ..utils._random import rng_from
+from ..utils._threads import frame_rows, limit_blas_threads
+from ._one_layer import BaseLayerModel
 
 __all__ = ["BaseStyleModel", "check_label_weights"]
 
@@ -118,7 +118,7 @@ class BaseStyleModel(BaseLayerModel):
         """Whether the model was fitted on labels (its context: label weights)."""
         return hasattr(self, "classes_")
 
-    def _fit_context(self, X, y, context, reset):
+    def _context_for_fit(self, X, y, context, reset):
         if reset and y is None and context is None:
             raise ValueError(
                 f"{type(self).__name__} requires y to be passed, but the target y "
@@ -126,7 +126,7 @@ class BaseStyleModel(BaseLayerModel):
                 "(n_frames,)) or label weights of shape (n_frames, n_classes), or a "
                 "real-valued context= of shape (n_frames, n_context)."
             )
-        return super()._fit_context(X, y, context, reset)
+        return super()._context_for_fit(X, y, context, reset)
 
     def _labels_context(self, y, X, reset):
         if y is None:

@@ -9,17 +9,17 @@ from sklearn.utils._array_api import (
 )
 from sklearn.utils._param_validation import Interval, StrOptions
 
-from ._base import FittedParameter
-from ._base_layer import BaseLayerModel
-from .layers._base import BINARY
-from .layers._crbm import (
+from ..layers._base import BINARY
+from ..layers._crbm import (
     MIN_LOG_VARIANCE,
     ORDER_CONSTRAINTS,
     CRBMLayer,
     hidden_order_of,
 )
-from .utils._array_api import array_ops
-from .utils._autoregression import ridge_autoregression
+from ..utils._array_api import array_ops
+from ..utils._autoregression import ridge_autoregression
+from ._base import FittedParameter
+from ._one_layer import BaseLayerModel
 
 # Ridge penalty of init="autoregressive": AutoregressiveImputer's default.
 _AUTOREGRESSIVE_ALPHA = 1.0
@@ -29,11 +29,9 @@ class ConditionalRBM(BaseLayerModel):
     """Conditional Restricted Boltzmann Machine for sequences of frames.
 
     Models each frame with Gaussian or binary visible units and binary hidden
-    units, conditioned on the previous frames of its sequence through
-    autoregressive and past-to-hidden weights (Taylor, Hinton & Roweis, 2006)
-    and, if given, on a real-valued per-frame ``context`` (control signals
-    such as speed), which adds to the same dynamic biases.  ``X`` stacks all
-    sequences; ``sequence_ids`` marks the frames of each.
+    units, given the previous frames of its sequence (Taylor, Hinton & Roweis,
+    2006) and, if given, a real-valued per-frame ``context`` such as a speed.
+    ``X`` stacks all sequences; ``sequence_ids`` marks the frames of each.
 
     Read more in the :ref:`User Guide <training>`.
 
@@ -49,75 +47,53 @@ class ConditionalRBM(BaseLayerModel):
         Gaussian units for standardised data, binary units for data in [0, 1].
     visible_variance : {"unit", "learned", "residual"}, default="unit"
         Variance of the Gaussian visibles: 1 (the paper's), trained per channel,
-        or fixed at the one-step residual of a ridge AR(``order``) per channel.
+        or the one-step residual of a ridge AR(``order``) per channel.
     init : {"random", "autoregressive"}, default="random"
-        Small random weights (the original code's), or start the autoregressive
-        part (and learned variances) from that ridge AR.
+        Small random weights, or the autoregressive part from that ridge AR.
     centering : bool, default=False
-        Take the gradient steps as if the hidden units saw the residual
-        ``(v - c_hat) / s`` of the frame against its dynamic visible mean.
+        Step as if the hidden units saw the frame's residual ``(v - c_hat) / s``.
     learning_rate : float, default=1e-3
         Step size for every parameter group.
-    momentum : float, default=0.9
-        Momentum used after the first ``momentum_delay`` epochs.
-    momentum_delay : int, default=5
-        Number of epochs trained without momentum.
+    momentum, momentum_delay : float, int, default=0.9, 5
+        Momentum, used after the first ``momentum_delay`` epochs.
     weight_decay : float, default=2e-4
         L2 penalty on the symmetric and directed weights (not on biases).
-    cd_steps : int, default=1
-        Number of alternating Gibbs steps per reconstruction (CD-k).
-    batch_size : int, default=100
-        Frames per minibatch.
+    cd_steps, batch_size : int, default=1, 100
+        Gibbs steps per reconstruction (CD-k); frames per minibatch.
     batching : {"balanced", "shuffled"}, default="balanced"
-        The paper's minibatches (one frame from each consecutive chunk of the
-        data) or the released code's (all frames shuffled every epoch).
+        The paper's minibatches (a frame per chunk) or its code's (shuffled).
     history_noise : float, default=1.0
-        Standard deviation of Gaussian noise added, in training only, to the
-        past frames (keeps generated motion in its style); ``0``: the paper's.
+        Standard deviation of noise on the past frames in training (paper: 0).
     history_noise_fraction : float in (0, 1], default=0.5
-        Probability with which each channel of a frame's history gets that
-        noise (the same at every lag); the other channels stay clean.
+        Probability that a channel of a frame's history gets that noise.
     average_fraction : float in [0, 1), default=0.25
-        :meth:`fit` keeps the mean of the parameters over this fraction of
-        its last epochs (Polyak-Ruppert averaging); ``0``: the last epoch's.
+        Fraction of the last epochs whose parameters :meth:`fit` averages.
     n_iter : int or "auto", default="auto"
-        Number of epochs (passes over the trainable frames).  ``"auto"``
-        depends on the data: enough epochs for 25,000 minibatch updates,
-        and at least 1000 (``ceil(25000 / ceil(n_trainable_frames /
-        batch_size))``): 1000 epochs for 2,500 frames or more, such as CMU
-        subject 35, more for smaller corpora, such as a dozen takes of
-        running, whose 1000 epochs would be too few updates for the
-        generated motion to stay alive.
-    ais_steps : int, default=50
-        Annealing steps of :meth:`score` where enumeration would cost more.
-    ais_chains : int, default=2
-        Annealing chains per frame.
+        Number of epochs.  ``"auto"``: enough for 25,000 minibatch updates,
+        and at least 1000 (:ref:`training`).
+    ais_steps, ais_chains : int, default=50, 2
+        Annealing steps, and chains per frame, of :meth:`score`.
     early_stopping : bool, default=False
         Hold out whole sequences in :meth:`fit`; keep the best-scoring epoch.
     validation_fraction : float, default=0.1
         Fraction of the frames, in whole sequences, held out.
-    n_iter_no_change : int, default=50
-        Epochs without an improvement of ``tol`` that stop training.
-    validation_interval : int, default=10
-        Epochs between two validation scores.
+    n_iter_no_change, validation_interval : int, default=50, 10
+        Epochs without an improvement of ``tol`` that stop training; epochs
+        between two validation scores.
     tol : float, default=1e-3
-        Improvement of the validation score, in nats per frame, that counts.
+        Improvement of the validation score (nats per frame) that counts.
     random_state : int, RandomState instance or None, default=None
         Seeds training and, unless :meth:`sample` is given its own, generation.
     verbose : int, default=0
-        Every ``verbose`` epochs, print the one-step prediction error on
-        training frames beside that of repeating the previous frame (a model
-        that learns predicts better), the reconstruction error and the time;
-        with ``early_stopping``, the validation log-likelihood too.
+        Every ``verbose`` epochs, print the prediction and reconstruction
+        errors, the time and the validation log-likelihood (if any).
 
     Attributes
     ----------
     components_ : ndarray of shape (n_components, n_features)
         Symmetric weights ``W`` between hidden and visible units.
-    intercept_hidden_ : ndarray of shape (n_components,)
-        Static hidden biases.
-    intercept_visible_ : ndarray of shape (n_features,)
-        Static visible biases.
+    intercept_hidden_, intercept_visible_ : ndarray
+        Static hidden biases (n_components,) and visible biases (n_features,).
     autoregressive_ : ndarray of shape (order, n_features, n_features)
         ``autoregressive_[q - 1] @ x[t - q]`` adds to frame ``t``'s visible mean.
     past_to_hidden_ : ndarray of shape (hidden_order, n_components, n_features)
@@ -125,19 +101,14 @@ class ConditionalRBM(BaseLayerModel):
     visible_variance_ : ndarray of shape (n_features,)
         Variance of each Gaussian visible unit (ones for ``"unit"``).
     context_to_visible_ : ndarray of shape (n_features, n_context)
-        ``context_to_visible_ @ y_t`` adds to frame ``t``'s visible mean, with
-        ``y_t`` the standardised context (``context_mean_``, ``context_scale_``).
+        ``context_to_visible_ @ y_t`` adds to frame ``t``'s visible mean.
     context_to_hidden_ : ndarray of shape (n_components, n_context)
         ``context_to_hidden_ @ y_t`` adds to frame ``t``'s hidden input.
     n_context_ : int
         Columns of the context the model was fitted with (0: none).
-    context_mean_ : ndarray of shape (n_context,)
-        Mean of each column of a real-valued context in ``fit``, which the
-        model subtracts from every context it is given (absent when fitted
-        without one).
-    context_scale_ : ndarray of shape (n_context,)
-        Standard deviation of each column (1 for a constant one), by which
-        the model divides every context it is given.
+    context_mean_, context_scale_ : ndarray of shape (n_context,)
+        Each context column's mean and standard deviation in ``fit`` (1 if
+        constant): ``y_t`` above is the context less the mean, over the scale.
     seed_windows_ : ndarray of shape (n_windows, width, n_features)
         Windows of consecutive training frames that seed :meth:`sample`.
     reconstruction_error_ : float
@@ -146,10 +117,8 @@ class ConditionalRBM(BaseLayerModel):
         Random generator state carried across :meth:`partial_fit` calls.
     n_iter_ : int
         Number of epochs trained so far.
-    validation_scores_ : list of float
-        With ``early_stopping``: the held-out score at every validation.
-    best_validation_score_ : float
-        With ``early_stopping``: the best of them, that of the parameters kept.
+    validation_scores_, best_validation_score_ : list of float, float
+        With ``early_stopping``: the held-out scores, and the best (kept).
     n_features_in_ : int
         Number of features seen during :term:`fit`.
     feature_names_in_ : ndarray of shape (`n_features_in_`,)
@@ -227,24 +196,28 @@ class ConditionalRBM(BaseLayerModel):
         random_state=None,
         verbose=0,
     ):
-        self.n_components = n_components
-        self.order = order
+        super().__init__(
+            n_components,
+            order=order,
+            learning_rate=learning_rate,
+            momentum=momentum,
+            momentum_delay=momentum_delay,
+            weight_decay=weight_decay,
+            cd_steps=cd_steps,
+            batch_size=batch_size,
+            batching=batching,
+            history_noise=history_noise,
+            history_noise_fraction=history_noise_fraction,
+            average_fraction=average_fraction,
+            n_iter=n_iter,
+            random_state=random_state,
+            verbose=verbose,
+        )
         self.hidden_order = hidden_order
         self.visible_type = visible_type
         self.visible_variance = visible_variance
         self.init = init
         self.centering = centering
-        self.learning_rate = learning_rate
-        self.momentum = momentum
-        self.momentum_delay = momentum_delay
-        self.weight_decay = weight_decay
-        self.cd_steps = cd_steps
-        self.batch_size = batch_size
-        self.batching = batching
-        self.history_noise = history_noise
-        self.history_noise_fraction = history_noise_fraction
-        self.average_fraction = average_fraction
-        self.n_iter = n_iter
         self.ais_steps = ais_steps
         self.ais_chains = ais_chains
         self.early_stopping = early_stopping
@@ -252,8 +225,6 @@ class ConditionalRBM(BaseLayerModel):
         self.n_iter_no_change = n_iter_no_change
         self.validation_interval = validation_interval
         self.tol = tol
-        self.random_state = random_state
-        self.verbose = verbose
 
     # The training of the paper and of its released code.
     _PAPER_SCHEDULE = dict(
@@ -282,10 +253,9 @@ class ConditionalRBM(BaseLayerModel):
         units, order 3, CD-1 with learning rate 1e-3 for every parameter
         group, momentum 0.9 after 5 epochs, weight decay 2e-4 on the
         weights, minibatches of 100 frames shuffled each epoch, clean
-        histories (``history_noise=0``), 4000 epochs.  The defaults differ
-        where measurements showed better models for every training seed
-        (``history_noise``, ``batching``); this keeps the paper's
-        experiments reproducible.
+        histories (``history_noise=0``), 4000 epochs: the paper's experiments
+        as they were run.  The defaults differ (``history_noise``,
+        ``batching``; :ref:`what_we_tried` says why).
 
         Parameters
         ----------

@@ -14,13 +14,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..exceptions import TrainingDivergedError
+from ..layers._parameters import MomentumUpdate, ParameterAverage
+from ..utils._array_api import array_ops, array_random, to_device_batches
+from ..utils._random import add_history_noise, rng_from
+from ..utils._sequences import balanced_batches, frame_history, shuffled_batches
 from ._gibbs import mean_field_prediction
-from .layers._parameters import MomentumUpdate, ParameterAverage
-from .utils._array_api import array_ops, array_random, to_device_batches
-from .utils._random import add_history_noise, rng_from
-from .utils._sequences import balanced_batches, frame_history, shuffled_batches
 
-__all__ = ["ProgressMonitor", "Schedule", "TrainingDivergedError", "train_epochs"]
+__all__ = ["ProgressMonitor", "Schedule", "train_epochs"]
 
 # Frames the progress report predicts one step ahead (evenly spaced).
 MONITOR_FRAMES = 1000
@@ -33,10 +34,6 @@ ONE_STEP_EXPLANATION = (
     "the motion goes on, and its generated motion tends to die out: train "
     "for more updates (n_iter) or on more frames."
 )
-
-
-class TrainingDivergedError(FloatingPointError):
-    """Training produced non-finite weights (the learning rate is too large)."""
 
 
 @dataclass(frozen=True)

@@ -10,8 +10,8 @@ import math
 
 import numpy as np
 
-from .utils._array_api import copy_array
-from .utils._random import _MIN_BIT_DRAWS, uniform
+from ..utils._array_api import copy_array
+from ..utils._random import _MIN_BIT_DRAWS, uniform
 
 __all__ = [
     "HiddenSampler",

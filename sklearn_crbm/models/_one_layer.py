@@ -1,7 +1,7 @@
 """What the one-layer models share: one conditional layer, trained by CD.
 
 :class:`BaseLayerModel` is the base of :class:`~sklearn_crbm.ConditionalRBM`
-and, through :class:`~sklearn_crbm._style_model.BaseStyleModel`, of
+and, through :class:`~sklearn_crbm.models._style.BaseStyleModel`, of
 :class:`~sklearn_crbm.FactoredCRBM` and :class:`~sklearn_crbm.LabelledCRBM`.
 """
 
@@ -17,17 +17,17 @@ from sklearn.utils._array_api import get_namespace_and_device, move_to
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import validate_data
 
-from ._base import BaseCRBM
-from ._training import ProgressMonitor, Schedule, train_epochs
-from .utils._array_api import array_ops
-from .utils._fitting import unfitted_on_error
-from .utils._random import rng_from
-from .utils._sequences import (
+from .._engines._training import ProgressMonitor, Schedule, train_epochs
+from ..utils._array_api import array_ops
+from ..utils._fitting import unfitted_on_error
+from ..utils._random import rng_from
+from ..utils._sequences import (
     check_sequence_ids,
     validation_split,
     warn_if_sequences_unmarked,
 )
-from .utils._threads import batch_rows, limit_blas_threads
+from ..utils._threads import batch_rows, limit_blas_threads
+from ._base import BaseCRBM
 
 __all__ = ["BaseLayerModel"]
 
@@ -42,7 +42,7 @@ class BaseLayerModel(BaseCRBM):
 
     :meth:`fit` and :meth:`partial_fit` validate the data, draw the layer's
     start parameters and train them with
-    :func:`~sklearn_crbm._training.train_epochs` (with early stopping on
+    :func:`~sklearn_crbm._engines._training.train_epochs` (with early stopping on
     held-out sequences if asked), keeping windows of real frames to seed
     :meth:`sample`.  Subclasses provide the hooks ``_new_layer`` (the layer,
     not yet initialised) and, where they need them, ``_check_training_data``
@@ -120,7 +120,7 @@ class BaseLayerModel(BaseCRBM):
             xp, _ = get_namespace_and_device(X)[:2]
             X = validate_data(self, X, dtype=[xp.float64, xp.float32], reset=True)
             sequences, frames = self._check_sequences(X, sequence_ids)
-            context = self._fit_context(X, y, context, reset=True)
+            context = self._context_for_fit(X, y, context, reset=True)
             self.random_state_ = check_random_state(self.random_state)
             self._initialize(X, context)
             if self.early_stopping:
@@ -171,7 +171,7 @@ class BaseLayerModel(BaseCRBM):
                 reset=first_call,
             )
             sequences, frames = self._check_sequences(X, sequence_ids)
-            context = self._fit_context(X, y, context, reset=first_call)
+            context = self._context_for_fit(X, y, context, reset=first_call)
         with unfitted_on_error(self):
             if first_call:
                 self.random_state_ = check_random_state(self.random_state)

@@ -9,13 +9,13 @@ from sklearn.utils._array_api import get_namespace
 from sklearn.utils._param_validation import HasMethods, Interval
 from sklearn.utils.validation import validate_data
 
+from ..utils._array_api import array_ops
+from ..utils._random import rng_from
+from ..utils._sequences import check_sequence_ids
+from ..utils._threads import batch_rows, limit_blas_threads
 from ._base import BaseCRBM
 from ._crbm import ConditionalRBM
-from ._style_model import _on_host
-from .utils._array_api import array_ops
-from .utils._random import rng_from
-from .utils._sequences import check_sequence_ids
-from .utils._threads import batch_rows, limit_blas_threads
+from ._style import _on_host
 
 __all__ = ["StackedCRBM"]
 
@@ -154,9 +154,6 @@ class StackedCRBM(BaseCRBM):
     (90, 6)
     """
 
-    # A stack pickled before ``estimator`` existed stacks ConditionalRBMs.
-    estimator = None
-
     # The hyper-parameters every layer takes from the stack as they are.
     _layer_parameters = (
         "order",
@@ -206,22 +203,24 @@ class StackedCRBM(BaseCRBM):
         verbose=0,
         estimator=None,
     ):
-        self.n_components = n_components
-        self.order = order
+        super().__init__(
+            n_components,
+            order=order,
+            learning_rate=learning_rate,
+            momentum=momentum,
+            momentum_delay=momentum_delay,
+            weight_decay=weight_decay,
+            cd_steps=cd_steps,
+            batch_size=batch_size,
+            batching=batching,
+            history_noise=history_noise,
+            history_noise_fraction=history_noise_fraction,
+            average_fraction=average_fraction,
+            n_iter=n_iter,
+            random_state=random_state,
+            verbose=verbose,
+        )
         self.hidden_order = hidden_order
-        self.learning_rate = learning_rate
-        self.momentum = momentum
-        self.momentum_delay = momentum_delay
-        self.weight_decay = weight_decay
-        self.cd_steps = cd_steps
-        self.batch_size = batch_size
-        self.batching = batching
-        self.history_noise = history_noise
-        self.history_noise_fraction = history_noise_fraction
-        self.average_fraction = average_fraction
-        self.n_iter = n_iter
-        self.random_state = random_state
-        self.verbose = verbose
         self.estimator = estimator
 
     # ------------------------------------------------------------ structure
@@ -255,7 +254,7 @@ class StackedCRBM(BaseCRBM):
             )
         return [float(v) for v in values]
 
-    def _new_layer(self, n_components, visible_type, seed, history_noise):
+    def _new_layer_estimator(self, n_components, visible_type, seed, history_noise):
         if self.estimator is None:
             params = self.get_params(deep=False)
             layer = ConditionalRBM(
@@ -298,7 +297,7 @@ class StackedCRBM(BaseCRBM):
                 f"but the longest sequence has {longest} {noun}. Pass longer "
                 "sequences (check sequence_ids), fewer layers or a lower order."
             )
-        return X, sequences, self._fit_context(X, None, context, reset)
+        return X, sequences, self._context_for_fit(X, None, context, reset)
 
     def _pass_up(self, layer, X, y, ids, context):
         """Hidden probabilities of ``layer`` on its valid frames, with their
@@ -350,7 +349,7 @@ class StackedCRBM(BaseCRBM):
         data = X
         for k, size in enumerate(sizes):
             seed = int(self.random_state_.randint(np.iinfo(np.int32).max))
-            layer = self._new_layer(
+            layer = self._new_layer_estimator(
                 size, "gaussian" if k == 0 else "binary", seed, noises[k]
             )
             layer.fit(data, y, sequence_ids=ids, context=context)
@@ -397,7 +396,7 @@ class StackedCRBM(BaseCRBM):
         if first_call:
             self.random_state_ = check_random_state(self.random_state)
             self.layers_ = [
-                self._new_layer(
+                self._new_layer_estimator(
                     size,
                     "gaussian" if k == 0 else "binary",
                     int(self.random_state_.randint(np.iinfo(np.int32).max)),
@@ -421,7 +420,7 @@ class StackedCRBM(BaseCRBM):
         layers = []
         for k, size in enumerate(self._layer_sizes()):
             visible_type = "gaussian" if k == 0 else "binary"
-            model = self._new_layer(size, visible_type, None, 0.0)
+            model = self._new_layer_estimator(size, visible_type, None, 0.0)
             layers += model._planned_layers(n_features)
             n_features = size
         return layers

@@ -5,10 +5,10 @@ from numbers import Integral, Real
 import numpy as np
 from sklearn.utils._param_validation import Interval
 
+from ..layers._factored import FactoredLayer
+from ..utils._array_api import to_numpy
 from ._base import FittedParameter
-from ._style_model import BaseStyleModel
-from .layers._factored import FactoredLayer
-from .utils._array_api import to_numpy
+from ._style import BaseStyleModel
 
 __all__ = ["FactoredCRBM"]
 
@@ -274,25 +274,29 @@ class FactoredCRBM(BaseStyleModel):
         random_state=None,
         verbose=0,
     ):
-        self.n_components = n_components
+        super().__init__(
+            n_components,
+            order=order,
+            learning_rate=learning_rate,
+            momentum=momentum,
+            momentum_delay=momentum_delay,
+            weight_decay=weight_decay,
+            cd_steps=cd_steps,
+            batch_size=batch_size,
+            batching=batching,
+            history_noise=history_noise,
+            history_noise_fraction=history_noise_fraction,
+            average_fraction=average_fraction,
+            n_iter=n_iter,
+            random_state=random_state,
+            verbose=verbose,
+        )
         self.n_factors = n_factors
         self.n_style_features = n_style_features
-        self.order = order
         self.shared_style_weights = shared_style_weights
-        self.learning_rate = learning_rate
-        self.momentum = momentum
-        self.momentum_delay = momentum_delay
         self.momentum_ramp = momentum_ramp
         self.balance_styles = balance_styles
         self.max_step = max_step
-        self.weight_decay = weight_decay
-        self.cd_steps = cd_steps
-        self.batch_size = batch_size
-        self.batching = batching
-        self.history_noise = history_noise
-        self.history_noise_fraction = history_noise_fraction
-        self.average_fraction = average_fraction
-        self.n_iter = n_iter
         self.n_gibbs = n_gibbs
         self.priors = priors
         self.ais_steps = ais_steps
@@ -302,8 +306,6 @@ class FactoredCRBM(BaseStyleModel):
         self.n_iter_no_change = n_iter_no_change
         self.validation_interval = validation_interval
         self.tol = tol
-        self.random_state = random_state
-        self.verbose = verbose
 
     def _train(self, X, frames, n_epochs, n_averaged=0, context=None):
         if self.balance_styles and self._labelled:
