@@ -1,33 +1,19 @@
 """Training and generation on a large corpus: CPU (1 and all threads) and GPU.
 
-Issue 18's configuration: a synthetic corpus of 10^6 frames x 100 channels
-(``_common.synthetic_motion``, 1000 sequences of 1000 frames, standardised),
-or a real corpus from ``--corpus FOLDER`` (every BVH file of the folder, or
-every AMC file with its ASF; preprocessed as the demo does), a CRBM with
-1000 hidden units and order 3, in float64 and float32.  Rows, the best of
-``--repeats`` timed calls (a run takes minutes, not hours):
+Issue 18's configuration: 10^6 synthetic frames x 100 channels
+(``_common.synthetic_motion``) or every BVH/AMC file of ``--corpus``
+(preprocessed as the demo does); 1000 hidden units, order 3, float64 and
+float32; best of ``--repeats``.  Rows: ``train`` (one epoch of
+``partial_fit`` on ``--train-frames`` frames, batch 100 and 1000, 1 and all
+BLAS threads), ``products`` (its six matrix products alone; ``/ products``
+is bounded at 1.3), ``sample`` (``--gen-frames`` frames of 1000 sequences
+together), and the same on a CUDA GPU through the array API when PyTorch
+sees one.  Peak memory: ``tracemalloc`` (GPU: ``max_memory_allocated``).
 
-- ``train``: ``partial_fit`` (one epoch, CD-1) on the first ``--train-frames``
-  frames of the corpus, in whole sequences, batch sizes 100 and 1000, with 1
-  BLAS thread and with all of them: frames per second;
-- ``products``: the six matrix products of the same minibatches alone (as in
-  ``bench_train.py``); ``train / products`` is the overhead the issue bounds
-  at 1.3;
-- ``sample``: ``sample`` of ``--gen-frames`` frames for 1000 sequences
-  together (30 Gibbs steps per frame): generated frames per second;
-- the same on a CUDA GPU through scikit-learn's array API (PyTorch tensors,
-  ``array_api_dispatch=True``) when PyTorch sees one; the table says so when
-  none is there.
-
-Peak memory: the largest traced allocation (``tracemalloc``) above what was
-held before each row, and for GPU rows ``torch.cuda.max_memory_allocated``.
-
-Run from the repository root (``SCIPY_ARRAY_API=1`` is set here for the GPU
-rows)::
+Run from the repository root::
 
     python benchmarks/bench_large.py                       # about 10 minutes
     python benchmarks/bench_large.py --frames 100000 --train-frames 10000
-    python benchmarks/bench_large.py --corpus ../shared/data/cmu_subject35
 """
 
 import argparse

@@ -1,19 +1,10 @@
 """Memory that ConditionalRBM.fit adds on top of its data, whatever the order.
 
-For each order (``--orders``), a fresh Python process builds ``--frames``
-(default 1,000,000) synthetic standardised frames of 62 dimensions in
-float32 (sequences of 100 frames), then fits a 200-hidden-unit CRBM for one
-epoch and reports:
-
-- ``traced MB``: the peak of memory allocated during ``fit`` (tracemalloc,
-  which sees numpy's buffers) above what was allocated before it;
-- ``peak RSS MB``: the growth of the process's peak resident memory during
-  ``fit`` (``VmHWM`` after resetting it through ``/proc/self/clear_refs``,
-  Linux only).
-
-The budget is the size of the data plus 150 MB; since the data already
-exists before ``fit``, what ``fit`` adds must stay under 150 MB for every
-order (history is gathered per minibatch by indexing, never materialised).
+Per order (``--orders``), a fresh process builds ``--frames`` (10^6)
+synthetic float32 frames of 62 dimensions (sequences of 100 frames), fits a
+200-hidden-unit CRBM for one epoch and reports the peak allocated during
+``fit`` above what was before (``tracemalloc``) and the growth of peak RSS
+(``VmHWM``, Linux).  Budget: what ``fit`` adds stays under 150 MB.
 
 Run from the repository root::
 

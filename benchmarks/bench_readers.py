@@ -1,20 +1,10 @@
 """Time of the file readers per megabyte, on huge skeletons and on real files.
 
-Readers must take time linear in the size of a file, whatever its shape: a
-BVH file with thousands of joints under one parent, or an ASF file with tens
-of thousands of bones, must read in well under a second per megabyte.  The
-script writes such files into a temporary folder and times:
-
-- ``read_bvh`` on a BVH file with ``--joints`` (default 5,000) joints under
-  one parent, each with three rotation channels, two frames;
-- ``Skeleton.from_asf`` on an ASF file with ``--bones`` (default 15,000)
-  bones in a binary tree;
-- ``read_bvh`` and ``read_amc`` on the largest real files of the development
-  set (``external_dev``: CMU 131_03 as BVH, the charleston dance as AMC).
-
-Each row is the best of ``--repeats`` calls, in wall-clock and process CPU
-seconds (the steadier measure on a shared machine), and is judged on the
-CPU seconds per megabyte.
+Readers must take time linear in a file's size, whatever its shape.  Timed
+(best of ``--repeats``, wall and process CPU seconds, judged on CPU seconds
+per MB): ``read_bvh`` on ``--joints`` (5,000) joints under one parent,
+``Skeleton.from_asf`` on ``--bones`` (15,000) bones in a binary tree, and
+``read_bvh``/``read_amc`` on the largest real files of ``external_dev``.
 
 Run from the repository root::
 

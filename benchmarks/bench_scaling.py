@@ -1,19 +1,11 @@
 """How the cost of a training epoch grows with frames, order and hidden units.
 
-Three sweeps around the paper's configuration (62 dimensions, 200 hidden
-units, order 3, minibatches of 100, CD-1, one BLAS thread), on synthetic
-standardised motion in sequences of 100 frames:
-
-- frames: 10^3 ... 10^6 (``--frames``); the cost per frame should stay flat
-  (minibatches gather their history by indexing);
-- order: 1 ... 12 (``--orders``) on 2644 frames (CMU 35's size);
-- hidden units: 50 ... 800 (``--components``) on 2644 frames.
-
-Each row gives ms per epoch (best of ``--repeats`` fits of ``--epochs``
-epochs, the input checks of ``fit`` included) in wall-clock and process CPU
-time, and from the CPU time microseconds per training frame, GFLOP/s from the
-shapes of the matrix products and the fraction of a 2000 x 2000 matrix
-product's rate in the same run.
+Around the paper's configuration (62 dimensions, 200 hidden units, order 3,
+batch 100, CD-1, one BLAS thread) on synthetic motion: frames 10^3-10^6
+(``--frames``; the cost per frame should stay flat), order 1-12
+(``--orders``) and hidden units 50-800 (``--components``) on 2644 frames.
+Per row: ms per epoch (best of ``--repeats``), us per frame, GFLOP/s and the
+fraction of a 2000 x 2000 product's rate.
 
 Run from the repository root (about two minutes)::
 

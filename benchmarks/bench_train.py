@@ -1,20 +1,13 @@
 """Training speed of ConditionalRBM against the machine's matrix-multiply peak.
 
-The paper's configuration: CMU subject 35 after preprocessing (2644 training
-frames in 31 trials, 62 dimensions), 200 hidden units, order 3, minibatches
-of 100 frames, CD-1, in float64 and float32, with 1 and 2 BLAS threads.  Each
-row times ``ConditionalRBM.fit`` over ``--epochs`` epochs (best and median of
-``--repeats``, wall and process CPU clock), counts the FLOPs of the matrix
-products of one epoch from their shapes and divides the rate by that of one
-2000 x 2000 matrix product timed in the same run (same dtype and threads).
-
-In the same run, interleaved: the six matrix products of every minibatch
-alone (the ceiling of any implementation that leaves them to BLAS; the
-column "/ products" is training over that time) and a straightforward numpy
-CD-1 ("x naive": its time over the package's).  The MIT walking
-configuration (3817 frames, 49 dimensions) is compared with the original
-MATLAB code, which took about 0.12 s per epoch under GNU Octave 7.3 with
-OpenBLAS on a two-core machine like the one these tables come from.
+The paper's configuration (CMU 35's 2644 training frames, 62 dimensions, 200
+hidden units, order 3, batch 100, CD-1), float64 and float32, 1 and 2 BLAS
+threads: ``fit`` over ``--epochs`` (best and median of ``--repeats``, wall
+and CPU clock), GFLOP/s from the products' shapes against a 2000 x 2000
+product in the same run.  Interleaved: the six matrix products of every
+minibatch alone ("/ products") and a straightforward numpy CD-1 ("x
+naive").  The MIT configuration is compared with the original MATLAB code
+(about 0.12 s per epoch under GNU Octave 7.3 on a like machine).
 
 Run from the repository root (a few minutes)::
 

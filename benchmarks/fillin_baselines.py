@@ -1,28 +1,16 @@
 """Filling in: the defaults against every simple baseline, by mean log ratio.
 
-Protocol (the paper's §4.4 on two splits of CMU subject 35, the paper's
-encoding): for each split (``paper``: walk 35_29 and jog 35_18 held out;
-``second``: walk 35_05 and jog 35_22) the left leg or the upper body of each
-held-out trial is erased from half-way to the end and filled on-line.
+The paper's §4.4 on two splits of CMU subject 35 (``paper``: 35_29 and
+35_18 held out; ``second``: 35_05 and 35_22), the paper's encoding: the left
+leg or the upper body of each held-out trial erased from half-way and
+filled on-line; the paper's error.  Baselines: ``NearestNeighborImputer``,
+``KNNImputer`` (1, 5, 10) and ``AutoregressiveImputer`` (full, diagonal);
+the CRBM: ``CRBMImputer`` around ``ConditionalRBM(random_state=seed)``
+(``--model``, ``--imputer``: JSON parameters).  Per kind of cell and
+pooled: the mean over seeds of ``log(CRBM error / best baseline error)``,
+its 95% bootstrap interval, and the seed-cells won.
 
-- baselines, fitted on the training trials: the paper's
-  ``NearestNeighborImputer``, scikit-learn's ``KNNImputer`` (1, 5 and 10
-  neighbours) and ``AutoregressiveImputer`` (AR(3), full and diagonal
-  covariance);
-- the CRBM: ``CRBMImputer`` around ``ConditionalRBM(random_state=seed)``,
-  both at their defaults (changed by ``--model`` and ``--imputer``, JSON
-  objects of parameters), one model per training seed, ``transform`` once;
-- error: the paper's (per erased frame the mean squared error over the
-  erased channels, summed over the erased frames, z-scored units).
-
-The criterion: per kind of cell (split x walk/jog x leg/upper body), the mean
-over training seeds of ``log(CRBM error / best baseline error)`` with its 95%
-bootstrap interval over seeds, the same pooled over all cells, and beside it
-the number of seed-cells in which the CRBM beats every baseline.  Negative
-is better than the best baseline; an interval below 0 is significant.
-
-Run from the repository root (about 5 minutes per model and split to train
-the first time; fitted models are cached)::
+Run from the repository root (fitted models are cached)::
 
     python benchmarks/fillin_baselines.py
     python benchmarks/fillin_baselines.py --seeds 0 --splits paper \\

@@ -1,26 +1,14 @@
 """Fill-in settings compared by cross-validation on the training trials alone.
 
-A setting chosen on the held-out cells of ``fillin_baselines.py`` is chosen
-on the test data.  This compares a setting on the 31 training trials of the
-paper's split (its test trials 35_29 and 35_18 are never read), preprocessed
-as there:
+The 31 training trials of the paper's split (its test trials are never
+read) in 3 folds of whole trials, walks and jogs in each; per fold the
+baselines of ``fillin_baselines.py`` and one CRBM per seed (``--model``,
+``--imputer``) fitted on the other folds, each trial filled with its left
+leg, then its upper body, erased from half-way.  Per seed, per kind of
+trial-cell and pooled: the mean ``log(CRBM error / best baseline error)``,
+its 95% bootstrap interval and the trial-cells won.
 
-- 3 folds of whole trials, walks and jogs in each (every third walk and
-  every third jog, in trial order);
-- per fold, every simple baseline of ``fillin_baselines.py`` and one CRBM
-  per training seed (the defaults of ``ConditionalRBM`` and ``CRBMImputer``,
-  changed by ``--model`` and ``--imputer``) are fitted on the other two
-  folds;
-- each trial of the fold is filled twice, with its left leg and with its
-  upper body erased from half-way to the end: 62 trial-cells per seed.
-
-Per seed: the total error and the mean over the trial-cells of
-``log(CRBM error / best baseline error)``; per kind of trial-cell
-(walk/jog x leg/upper body) and over all of them: that mean over seeds with
-its 95% bootstrap interval over seeds, and the trial-cells won.
-
-Run from the repository root (12 fits of the default model the first time;
-fitted models are cached)::
+Run from the repository root (fitted models are cached)::
 
     python benchmarks/fillin_cv.py
     python benchmarks/fillin_cv.py --model '{"batch_size": 200}'

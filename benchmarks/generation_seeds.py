@@ -1,24 +1,15 @@
 """Generation: do generated walks and jogs keep their style, for every seed?
 
-Protocol, per training seed and joint encoding (``--encodings``: the
-paper's, ``reference="rest", roll="taylor"``, and the package's default):
+Per training seed and encoding (``--encodings``: the paper's and the
+default): ``ConditionalRBM(random_state=seed)`` (``--model``) on all 33
+trials of CMU 35; 6 walk- and 6 jog-seeded sequences of 1000 frames
+(``MotionPipeline.style_windows``); frames 200-299 and 900-999 judged
+(``metrics.judge_generated_motion``): a window passes when it keeps its
+seed's style, stays within |z| <= 10, and its leg amplitude is within 25%
+and step frequency within 15% of its style's real trials.  Criterion:
+windows passing (240 for seeds 0-4 and both encodings).
 
-- one ``ConditionalRBM(random_state=seed)`` (the defaults, changed by
-  ``--model``) on all 33 trials of CMU subject 35, preprocessed;
-- 6 walk-seeded and 6 jog-seeded sequences of 1000 frames, each seeded with
-  ``history_length`` real frames of its style
-  (``MotionPipeline.style_windows``), ``sample`` at its defaults;
-- each sequence judged (``metrics.judge_generated_motion``) over frames
-  200-299 and 900-999: it *passes* a window when it keeps its seed's style
-  (the nearest real style on speed and step frequency), never leaves
-  |z| <= 10, and its leg amplitude is within 25% and its step frequency
-  within 15% of the mean of the real trials of its style.
-
-The criterion is the number of windows passing: 2 windows x 12 sequences per
-seed and encoding, 240 for seeds 0-4 and both encodings.
-
-Run from the repository root (10 fits of the default model the first time;
-fitted models are cached)::
+Run from the repository root (fitted models are cached)::
 
     python benchmarks/generation_seeds.py
     python benchmarks/generation_seeds.py --seeds 0 --encodings paper

@@ -1,27 +1,15 @@
 """Held-out log-likelihood of the CRBM against linear-Gaussian AR(3) models.
 
-On the two splits of CMU subject 35 of ``fillin_baselines.py`` (the paper's
-encoding), the mean held-out ``log p(x_t | past)`` in nats per frame, over
-every frame of the held-out walk and jog with 3 past frames:
+On the splits of ``fillin_baselines.py``: the mean held-out ``log p(x_t |
+past)`` (nats per frame) of the ridge AR(3) with unit, per-channel and full
+residual variance (closed form); ``ConditionalRBM()``; and the density model
+(``init="autoregressive"``, ``visible_variance="residual"``,
+``centering=True``, clean histories, 60 epochs), also with ``W`` and the
+past-to-hidden weights set to 0.  CRBM scores are
+``estimate_log_likelihood``'s forward and reverse annealed estimates
+(``--ais STEPS CHAINS``; default 50 x 2).
 
-- the ridge AR(3) of ``AutoregressiveImputer`` fitted on the training
-  trials, with unit variance (what ``visible_variance="unit"`` assumes),
-  per-channel variances and its full residual covariance, in closed form;
-- ``ConditionalRBM()`` (the defaults, unit variances: a model made to fill
-  in and generate), one per training seed;
-- the density model: ``init="autoregressive"``,
-  ``visible_variance="residual"`` (the ridge AR's residual variances, fixed),
-  ``centering=True``, clean histories, 60 epochs, one per training seed, and
-  the same models with ``W`` and the past-to-hidden weights set to 0 (a
-  linear AR): what the hidden units add.
-
-CRBM scores are ``ConditionalRBM.estimate_log_likelihood``: annealed
-importance sampling (forward) and its reverse estimate, whose gap bounds the
-error of either; ``--ais STEPS CHAINS`` anneals longer than the models'
-default 50 x 2.
-
-Run from the repository root (the default models are those of
-``fillin_baselines.py``, shared through the cache)::
+Run from the repository root (models shared with ``fillin_baselines.py``)::
 
     python benchmarks/likelihood_baselines.py
     python benchmarks/likelihood_baselines.py --ais 500 16

@@ -1,24 +1,14 @@
 """Model selection: what the held-out log-likelihood picks, against the fill-in error.
 
-What ``GridSearchCV(scoring=None)`` does with a ``ConditionalRBM`` on CMU
-subject 35, measured fold by fold:
+``GridSearchCV(scoring=None)`` with ``ConditionalRBM`` on CMU 35, fold by
+fold: 3 folds of whole trials (walks and jogs in each); ``--sizes`` hidden
+units x ``--orders``, ``--n-iter`` epochs (``--model``); per model and fold
+``score`` (nats per frame) and its time, and ``CRBMImputer``'s fill-in
+error (``--imputer``; left leg, then upper body, erased from half-way).
+Reports the Spearman correlation of score and minus fill-in error (order
+>= 1), the pick and its fill-in against the grid's best.
 
-- data: all 33 trials in 3 folds of whole trials, walks and jogs in every
-  fold (the k-th walk and the k-th jog go to fold ``k % 3``); the package's
-  preprocessing fitted on the training folds;
-- grid: ``--sizes`` hidden units x ``--orders``, ``--n-iter`` epochs, the
-  other parameters at their defaults (changed by ``--model``);
-- per model and held-out fold: ``score`` (mean held-out log-likelihood per
-  frame, nats), its time against the fit's, and the fill-in error of
-  ``CRBMImputer`` on the model (its defaults, changed by ``--imputer``): the
-  left leg, then the upper body, erased from half-way through every
-  held-out trial, mean squared error per erased entry, the two averaged;
-- the Spearman correlation between the score and minus the fill-in error
-  over the models with ``order >= 1``, the configuration the search picks
-  (the highest mean score) and its fill-in error against the grid's best.
-
-Run from the repository root (48 fits of up to 400 hidden units the first
-time; fitted models are cached)::
+Run from the repository root (fitted models are cached)::
 
     python benchmarks/model_selection.py
     python benchmarks/model_selection.py --sizes 10 50 --orders 1 3

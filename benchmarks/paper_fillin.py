@@ -1,28 +1,16 @@
 """The paper's fill-in experiment (§4.4) on CMU subject 35, against nearest neighbour.
 
-Protocol (Taylor, Hinton & Roweis 2006, §4.4): train on the 31 training
-trials (the paper's encoding, preprocessing fitted on them); erase the left
-leg or the upper body of the walk 35_29 and of the jog 35_18 from half-way
-to the end; fill in on-line; score with the paper's error (per erased frame
-the mean squared error over the erased channels, summed over the erased
-frames) and in degrees, the CRBM by the mean of ``--n-repeats`` single draws
-(``model_selection.compare_imputers``).  The paper reports, for the walk:
-left leg 8.78 (nearest neighbour 11.68), upper body 20.52 (22.20).
+Train on the 31 training trials (the paper's encoding); erase the left leg
+or the upper body of 35_29 and 35_18 from half-way; fill in on-line; the
+paper's error and degrees, the CRBM by the mean of ``--n-repeats`` single
+draws.  The paper, for the walk: leg 8.78 (nearest neighbour 11.68), upper
+body 20.52 (22.20).  ``--variants``: ``paper``
+(``ConditionalRBM.paper_schedule()``, single-chain ``CRBMImputer``) and
+``defaults``.  Baselines: ``NearestNeighborImputer``, ``KNNImputer(5)``,
+``IterativeImputer``.  Per variant and cell: the mean log ratio to nearest
+neighbour over seeds, its 95% bootstrap interval, the seeds that beat it.
 
-Variants (``--variants``), one model per training seed:
-
-- ``paper``: ``ConditionalRBM.paper_schedule()`` (4000 epochs, clean
-  histories) with the paper's single-chain fill-in,
-  ``CRBMImputer(n_particles=1, offset_shrinkage=None, observation_gain=1)``;
-- ``defaults``: ``ConditionalRBM()`` and ``CRBMImputer()``.
-
-Baselines: the paper's ``NearestNeighborImputer``, scikit-learn's
-``KNNImputer(5)`` and ``IterativeImputer``.  Per variant and cell: the mean
-over seeds of ``log(CRBM error / nearest neighbour's)`` with its 95%
-bootstrap interval, and the seeds that beat nearest neighbour.
-
-Run from the repository root (10 fits the first time, the paper's of 4000
-epochs; fitted models are cached)::
+Run from the repository root (fitted models are cached)::
 
     python benchmarks/paper_fillin.py
     python benchmarks/paper_fillin.py --variants defaults --seeds 0 --n-repeats 10

@@ -1,29 +1,15 @@
 """The paper's generation experiments: styles (§4.1), stacks (§4.2, §5), transitions (§4.3).
 
-``styles``: each model, per training seed, generates 300 frames from each of
-6 seeds of real frames per style (``MotionPipeline.style_windows``); the last
-100 frames of every sequence are judged by ``metrics.judge_generated_motion``
-(the nearest real style on speed and step frequency; died out, stalled,
-blown up).  A seed passes the paper's bar when, for every style, at least 5
-of 6 sequences keep their style, none blows up and at most one dies out.
-Models (``--models``), each trained on all the data of ``--datasets``:
-
-- ``paper``: ``ConditionalRBM.paper_schedule(n_iter=1000)`` (clean
-  histories, shuffled minibatches);
-- ``defaults``: ``ConditionalRBM()``;
-- ``stacked``: the two-level model of §5, ``StackedCRBM((200, 200),
-  order=3, n_iter=500)``, generating top-down as the original ``gen2.m``;
-- ``stacked-noisy``: the same with ``history_noise=0.4`` in both layers.
-
-Data: ``cmu`` (the 23 walks and 10 jogs of CMU subject 35, the package's
-encoding) and ``mit`` (Taylor's MIT walks, the data of the original two-level
-demo; §4.2's walk/jog file is not public).
-
-``transitions`` (§4.3): the ``defaults`` model of CMU 35 generates 12
-sequences of 1200 frames (half walk-, half jog-seeded) with Gaussian noise of
-standard deviation ``hidden_noise`` on the hidden biases; every window of 60
-frames (hop 30) is labelled walk, jog, still (died out or stalled) or blown,
-and switches between walk and jog are counted per direction.
+``styles``: per model and seed, 300 frames from each of 6 real seed windows
+per style, the last 100 judged (``metrics.judge_generated_motion``); a seed
+passes when for every style at least 5 of 6 keep it, none blows up and at
+most one dies out.  ``--models``: ``paper``
+(``paper_schedule(n_iter=1000)``), ``defaults``, ``stacked``
+(``StackedCRBM((200, 200), order=3, n_iter=500)``) and ``stacked-noisy``
+(``history_noise=0.4``); ``--datasets``: ``cmu`` (CMU 35) and ``mit``.
+``transitions``: the CMU ``defaults`` model, 12 sequences of 1200 frames
+with ``hidden_noise``; windows of 60 frames labelled walk, jog, still or
+blown, and switches counted per direction.
 
 Run from the repository root::
 

@@ -1,26 +1,16 @@
 """Style recognition: FactoredCRBM's predict and predict_proba on held-out takes.
 
-Data: the Bandai Namco walks in seven styles (``load_bandai_walks``), through
-the default ``make_motion_preprocessor`` fitted on takes 001-005 of every
-style; a ``FactoredCRBM`` of the default size (600 hidden units, 200 factors,
-order 6) trained on the same takes for ``--n-iter`` epochs (fewer than the
-default 200 by default: the time recognition takes does not depend on the
-epochs, only its accuracy does).  Recognised: the first ``--frames`` frames
-of every take 006 (120 frames: 840 frames of 7 styles).
-
-Per training seed, one BLAS thread: seconds of ``predict`` then
-``predict_proba`` of the same frames (wall clock and process CPU time; the
-CPU time leaves out waiting for a core on a shared machine), seconds of
-``predict_proba`` alone on a model that has not seen the frames (one
-annealing pass per style: what each of the two calls cost before they
-shared it), and the share of takes whose style is recognised.  Means over seeds with 95%
-bootstrap intervals.
+The Bandai walks (default preprocessing fitted on takes 001-005); a
+default-size ``FactoredCRBM`` trained on them for ``--n-iter`` epochs
+(recognition's time does not depend on it); the first ``--frames`` (120)
+frames of every take 006.  Per seed, one BLAS thread: wall and CPU seconds
+of ``predict`` then ``predict_proba`` of the same frames, of
+``predict_proba`` alone on a fresh model, and the takes recognised; means
+over seeds with 95% bootstrap intervals.
 
 Run from the repository root::
 
     python benchmarks/recognition.py --seeds 0 1 2
-
-Prints one table and writes JSON to ``benchmarks/results/recognition.json``.
 """
 
 import os

@@ -1,37 +1,18 @@
 """Speed control: does a model trained with its speed as context go as fast as asked?
 
-Protocol, per training seed (``--seeds``, 0-4):
+Per seed: ``ConditionalRBM(random_state=seed)`` (``--model``) on all 33
+trials of CMU 35, the default preprocessing, with every frame's forward
+speed as ``context`` (``MotionContext(signals=["forward_speed"])``, 1-s
+window, units per second).  Requests from ``--n-sequences`` real seed
+windows, 600 frames: constant speed at the walks' mean, the jogs' mean,
+their midpoint and 10% beyond the fastest jog; a ramp of 100 frames at walk
+speed, 300 rising, 200 at jog speed.  Measured: generated speed over frames
+200-599 and its error as a fraction of jog - walk; leg amplitude against
+the nearest real style (alive within 25%); blown beyond |z| 10; the ramp's
+correlation of requested and generated speed over frames 50-599.  Targets
+(issue 36): |error| <= 0.15, alive, correlation >= 0.9.
 
-- all 33 trials of CMU subject 35 (23 walks, 10 jogs), the default
-  preprocessing (``make_motion_preprocessor``, the steps of
-  ``make_motion_pipeline``) and ``ConditionalRBM(random_state=seed)`` (the
-  defaults, changed by ``--model``), trained with every frame's forward speed
-  as its ``context``: ``MotionContext(skeleton, signals=["forward_speed"])``,
-  smoothed over 1 s, in ASF length units per second, as it is (the model
-  standardises its context);
-- requests, each generated from ``--n-sequences`` real seed windows
-  (``MotionPipeline.style_windows``, drawn with the training seed): a constant
-  speed at the mean of the real walks' frames, at the mean of the jogs'
-  frames, at their midpoint (no training frame is within 5 units/s of it) and
-  10% beyond the fastest jog trial's mean, each over 600 frames; and a ramp of
-  100 frames at the walks' speed, 300 frames rising to the jogs' speed and 200
-  at it.  Walk seeds for the walk, the midpoint and the ramp; jog seeds for
-  the jog and beyond it.
-- measures, per sequence: the generated forward speed (``MotionContext`` of
-  the generated raw channels) over frames 200-599 and its error as a fraction
-  of the jog-walk speed difference; its leg amplitude over frames 200-599
-  (``metrics.judge_generated_motion``) over the mean amplitude of the real
-  trials of its nearest real style (in speed and step frequency): *alive*
-  within 25%; *blown* beyond |z| 10 in any frame; for the ramp, the
-  correlation of the requested speed with the generated speed (1-s window)
-  over frames 50-599.
-
-Targets (issue 36): |error| <= 0.15 for the three constant requests, alive,
-ramp correlation >= 0.9, beyond the fastest jog alive and not blown; means
-over the training seeds with 95% bootstrap intervals.
-
-Run from the repository root (5 fits of about a minute the first time;
-fitted models are cached)::
+Run from the repository root (fitted models are cached)::
 
     python benchmarks/speed_control.py
 """

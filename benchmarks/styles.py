@@ -1,58 +1,34 @@
 """Many styles from one model: the factored CRBM's criteria (issues 29, 35).
 
-Data: the Bandai Namco walks in seven styles (``load_bandai_walks``: takes
-001-006 of active, elderly, exhausted, feminine, masculine, normal and
-youthful, 30 frames per second), through the default
-``make_motion_preprocessor`` fitted on the training frames: takes 001-005
-of every style; the takes 006 are held out.  Model: ``FactoredCRBM`` with
-the package's defaults, trained per seed of ``--seeds`` (``--n-iter``
-shortens training).
+The Bandai walks in seven styles (``load_bandai_walks``, 30 frames per
+second), the default ``make_motion_preprocessor`` fitted on takes 001-005;
+the takes 006 are held out.  ``FactoredCRBM`` with the defaults per seed of
+``--seeds`` (``--n-iter`` shortens training).  Parts (``--parts``):
 
-Measurements, each of ``--parts``:
+- ``style``: per style, ``--n-sequences`` x ``--n-frames`` frames seeded
+  with a normal walk: 2-s windows from frame 100 judged the style (kept)
+  and alive (``StyleJudge`` on all 42 takes); leg amplitude and step
+  frequency over the last 100 frames within 25% and 15% of the style's;
+  blow-ups (beyond twice a channel's largest real |z|).
+- ``blends``: the 21 pairs at 50/50: windows judged one of the two; forward
+  speed and step frequency between the two styles' (10% margin).
+- ``transitions``: the 42 ordered pairs switched at half the sequence:
+  windows from 60 frames after the switch judged the new style and alive.
+- ``likelihood``: held-out log-likelihood per frame of the takes 006 (from
+  their 13th frame), its standard error and the reverse estimate's gap.
+- ``recognition``: ``predict`` on the first 300 frames of every take 006.
+- ``fillin``: left leg or upper body of every take 006 erased from
+  half-way: mean log ratio of the error to the best of ``KNNImputer(5)``,
+  ``KNNImputer(10)`` and ``AutoregressiveImputer()``, 95% bootstrap interval.
+- ``speed``: seconds per epoch; frames per second generating 1 and 100
+  sequences; the matrix products alone of 100 sequences as a fraction of
+  their generation's time (at least 0.6).
 
-- ``style``: per style, ``--n-sequences`` sequences of ``--n-frames``
-  frames seeded with real frames of a *normal* walk and asked for the style:
-  the share of 2-s windows from frame 100 on that the judge (``StyleJudge``
-  trained on all 42 real takes) calls the style ("kept"), the share also
-  alive, and over the last 100 frames the leg amplitude and step frequency
-  of every sequence as a ratio to the style's real 100-frame windows (pass:
-  within 25% and 15%); blow-ups (a channel beyond twice its largest
-  magnitude in the real takes).
-- ``blends``: the 21 pairs of styles at 50/50: windows judged as one of the
-  two; forward speed and step frequency between the two styles' real ones
-  (within 10% of their difference).
-- ``transitions``: the 42 ordered pairs, seeded with frames of the first
-  style, switched to the second at half the sequence: windows from 60
-  frames after the switch judged as the new style, alive, and both.
-- ``likelihood``: held-out log-likelihood per frame of the takes 006 with
-  their labels (frames from the 13th of each take, so that every order up
-  to 12 has a full history), with the standard error of the annealed
-  estimate and the gap to the reverse (conservative) estimate.
-- ``recognition``: the style of the first 300 frames of every take 006
-  (``predict``).
-- ``fillin``: the left leg (``UpperLeg_L`` down) or the upper body
-  (``Spine`` up) of every take 006 erased from half-way: the log ratio of
-  the paper's fill-in error to the best of ``KNNImputer(5)``,
-  ``KNNImputer(10)`` and ``AutoregressiveImputer()``, averaged over styles,
-  parts and seeds, with a 95% bootstrap interval.
-- ``speed``: training seconds per epoch; generation frames per second for
-  one sequence and per sequence of 100 generated together (the default
-  Gibbs steps); the time of the matrix products alone of 100 sequences
-  generated together as a fraction of the generation's (the batch
-  criterion: at least 0.6).
-
-Run from the repository root, e.g.::
+Run from the repository root; results are cached per seed, keyed by the
+code, and ``--tabulate`` merges earlier runs' JSON (seeds run apart)::
 
     python benchmarks/styles.py --seeds 0 --n-iter 50
-    python benchmarks/styles.py --parts style likelihood
     python benchmarks/styles.py --tabulate seed0.json seed1.json
-
-Prints one table of the measures over the seeds (shares kept and alive,
-transitions and fill-in as means with a 95% bootstrap interval over the
-seeds), the share kept and alive per style and one row per seed, and writes
-JSON to ``benchmarks/results/styles.json``; ``--tabulate`` prints the tables
-of earlier runs' JSON files (seeds run in separate processes) merged.
-Results are cached per seed (``_common.CACHE``), keyed by the code.
 """
 
 import os
