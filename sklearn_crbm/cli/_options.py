@@ -349,9 +349,9 @@ COMMANDS = {
                 "--hidden-noise",
                 type=float,
                 default=0.0,
-                help="noise on the hidden biases, for style transitions (paper "
-                "§4.3); measured on CMU 35: no walk-to-jog transition up to 2.0, "
-                "a few from 2.5, nearly every walk from 4.0",
+                help="standard deviation of Gaussian noise on the hidden biases "
+                "at every frame: 0 follows the model's own dynamics, more noise "
+                "lets the motion switch styles (paper §4.3)",
             ),
             _option(
                 "--seed",
