@@ -27,8 +27,9 @@ class ContextMixin:
     - ``_online_context(X, context)``: what on-line fill-in conditions on;
     - ``_context_hint``: how else the model can be told its context;
     - ``_scales_context``: whether ``fit`` learns the scaling of a
-      real-valued context (a :class:`~sklearn_crbm.StackedCRBM` scales it
-      once for all its layers, and turns it off on them).
+      real-valued context; :meth:`_take_context_as_given` turns it off (a
+      :class:`~sklearn_crbm.StackedCRBM` scales the context once for all
+      its layers).
     """
 
     # how else a model can be told its context (said when one is missing)
@@ -36,6 +37,16 @@ class ContextMixin:
 
     # whether fit learns the scaling of a real-valued context
     _scales_context = True
+
+    def _take_context_as_given(self):
+        """Make ``fit`` take a real-valued context as it is, unscaled.
+
+        For a model whose owner standardises the context for it (a
+        :class:`~sklearn_crbm.StackedCRBM` does, once for all its layers).
+        Returns ``self``.
+        """
+        self._scales_context = False
+        return self
 
     def _labels_context(self, y, X, reset):
         """Every frame's context from the labels ``y`` (None: ``y`` is ignored)."""

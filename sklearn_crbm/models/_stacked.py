@@ -271,8 +271,7 @@ class StackedCRBM(BaseCRBM):
                 own["visible_type"] = visible_type
             layer.set_params(**own)
         # the stack standardises a real-valued context once, for every layer
-        layer._scales_context = False
-        return layer
+        return layer._take_context_as_given()
 
     def _check_fit_input(self, X, sequence_ids, context, reset):
         xp = get_namespace(X)[0]
