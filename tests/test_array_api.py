@@ -319,7 +319,7 @@ def test_pickling_keeps_the_namespace_and_moving_to_numpy_keeps_the_model(
     model.fit(X_xp, given.get("style"), sequence_ids=ids)
     expected = _numpy(model.transform(X_xp, **given, sequence_ids=ids))
     loaded = pickle.loads(pickle.dumps(model))
-    _same_place(loaded._layers()[0].flat, X_xp)
+    _same_place(loaded._fitted_layers()[0].flat, X_xp)
     np.testing.assert_array_equal(
         _numpy(loaded.transform(X_xp, **given, sequence_ids=ids)), expected
     )
@@ -332,7 +332,7 @@ def test_pickling_keeps_the_namespace_and_moving_to_numpy_keeps_the_model(
             atol=1e-6,
         )
         on_numpy.partial_fit(X, given.get("style"), sequence_ids=ids)  # and trains on
-    assert isinstance(on_numpy._layers()[0].flat, np.ndarray)
+    assert isinstance(on_numpy._fitted_layers()[0].flat, np.ndarray)
 
 
 @pytest.mark.parametrize("namespace, device_name, dtype_name", DEVICE_COMBINATIONS)
@@ -364,7 +364,7 @@ def test_style_models_fit_and_run_on_the_input_device_as_on_numpy(
     model = _small_model(estimator).fit(X_xp, styles, sequence_ids=ids)
     model.partial_fit(X_xp, styles, sequence_ids=ids)
     assert model.n_iter_ == 3
-    _same_place(model._layers()[0].flat, X_xp)
+    _same_place(model._fitted_layers()[0].flat, X_xp)
     _same_place(model.seed_windows_, X_xp)
     blend = np.full((4, 2), 0.5)  # half of each style, every frame
     for output in (
@@ -421,7 +421,7 @@ def test_a_model_of_a_context_runs_on_the_input_device_as_on_numpy(
     model = _small_model("crbm").fit(X_xp, sequence_ids=ids, context=context_xp)
     model.partial_fit(X_xp, sequence_ids=ids, context=context_xp)
     assert model.n_iter_ == 3 and model.n_context_ == 2
-    _same_place(model._layers()[0].flat, X_xp)
+    _same_place(model._fitted_layers()[0].flat, X_xp)
     for output in (
         model.sample(4, context=context_xp[:1, ...], n_sequences=3, random_state=0),
         model.sample(4, context=context[:4], history=X_xp[:2, ...], random_state=0),
@@ -610,7 +610,7 @@ def test_particle_resampling_is_numpy_s_given_the_same_draws(
     frames, observed = X[:n_sequences], X[:n_sequences] > 0
     results = []
     for estimator, to in ((model, np.asarray), (moved, partial(_to, xp, device))):
-        history = History.from_frames(estimator._layers(), to(past))
+        history = History.from_frames(estimator._fitted_layers(), to(past))
         chains = _ancestors(
             history.frame_rbms(),
             to(frames),

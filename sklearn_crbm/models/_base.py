@@ -69,8 +69,8 @@ class BaseCRBM(
     :meth:`predict_next`, :meth:`score`, :meth:`score_samples` and
     :meth:`estimate_log_likelihood`, :meth:`sample` with its seed windows,
     and the constants.  Subclasses fit, and provide the hooks
-    :attr:`history_length`, ``_layers`` (every fitted layer) and, where they
-    differ from the defaults, ``_ais_settings`` and ``_chain_rng``.
+    :attr:`history_length`, ``_fitted_layers`` (every fitted layer) and,
+    where they differ from the defaults, ``_ais_settings`` and ``_chain_rng``.
 
     Every method that depends on time takes the same per-frame ``context``
     (shape ``(n_frames, n_context)``, real-valued), which every layer gets
@@ -145,8 +145,12 @@ class BaseCRBM(
     # ---------------------------------------------------------------- hooks
 
     @abstractmethod
-    def _layers(self):
+    def _fitted_layers(self):
         """The fitted :class:`~sklearn_crbm.layers.ConditionalLayer` s, bottom first."""
+
+    def _layers(self):
+        # the old name, for models/_sampling.py's calls until they are renamed
+        return self._fitted_layers()
 
     @abstractmethod
     def _planned_layers(self, n_features):
@@ -163,7 +167,7 @@ class BaseCRBM(
         sequence.
         """
         # the past a layer takes does not depend on its number of features
-        layers = self._layers() if _is_fitted(self) else self._planned_layers(1)
+        layers = self._fitted_layers() if _is_fitted(self) else self._planned_layers(1)
         return sum(layer.n_lags for layer in layers)
 
     def _matrix_product_size(self, n_features=None):
@@ -174,7 +178,7 @@ class BaseCRBM(
         (:mod:`sklearn_crbm.utils._threads`).
         """
         fitted = _is_fitted(self)
-        layers = self._layers() if fitted else self._planned_layers(n_features)
+        layers = self._fitted_layers() if fitted else self._planned_layers(n_features)
         return max(layer.product_size() for layer in layers)
 
     def _ais_settings(self):
@@ -194,7 +198,7 @@ class BaseCRBM(
     def n_context_(self):
         """Columns of the per-frame ``context`` the model was fitted with (0: none)."""
         check_is_fitted(self)
-        return self._layers()[0].n_context
+        return self._fitted_layers()[0].n_context
 
     # ------------------------------------------------------------------ fit
 
@@ -225,14 +229,14 @@ class BaseCRBM(
     def _transform_training_data(self, X, y, sequence_ids, context):
         X, sequences = self._check_inference_input(X, sequence_ids)
         context = self._context_for_fit(X, y, context, reset=False)
-        return self._representations(X, sequences, self._layers(), context)[-1]
+        return self._representations(X, sequences, self._fitted_layers(), context)[-1]
 
     # ------------------------------------------------------------ inference
 
     @property
     def _packed_parameters(self):
         """The bottom layer's parameter buffer: the fitted namespace and device."""
-        return self._layers()[0].flat
+        return self._fitted_layers()[0].flat
 
     def _check_namespace(self, X, method):
         """A clear error unless ``X`` can meet the fitted parameters."""
@@ -253,7 +257,7 @@ class BaseCRBM(
         xp = get_namespace(X)[0]
         X = validate_data(self, X, dtype=[xp.float64, xp.float32], reset=False)
         ops = array_ops(X)
-        X = ops.astype(X, self._layers()[0].dtype, copy=False)
+        X = ops.astype(X, self._fitted_layers()[0].dtype, copy=False)
         return X, check_sequence_ids(sequence_ids, X.shape[0])
 
     def _representations(self, X, sequences, layers, context=None):
@@ -269,7 +273,7 @@ class BaseCRBM(
 
     def _stack_chunks(self, X, sequences, frames=None, context=None):
         """Yield ``(rows, stack)``: every layer's frame RBMs of chunks of frames."""
-        layers = self._layers()
+        layers = self._fitted_layers()
         representations = self._representations(X, sequences, layers[:-1], context)
         chunks = zip(
             *(
@@ -316,7 +320,7 @@ n_classes), default=None
         """
         X, sequences = self._check_inference_input(X, sequence_ids)
         context = self._given_context(X, sequences, context, style)
-        return self._representations(X, sequences, self._layers(), context)[-1]
+        return self._representations(X, sequences, self._fitted_layers(), context)[-1]
 
     @limit_blas_threads(frame_rows)
     def predict_next(self, X, *, sequence_ids=None, context=None, style=None):
@@ -420,7 +424,7 @@ n_classes), default=None
         self, X, sequences, method="auto", reverse=False, rng=None, context=None
     ):
         """:class:`~sklearn_crbm._engines._likelihood.LogLikelihood` of every frame."""
-        layers = self._layers()
+        layers = self._fitted_layers()
         n_steps, n_chains = self._ais_settings()
         rng = rng_from(self.random_state) if rng is None else rng
         rng = array_random(rng, X)  # numpy's own stream for numpy input
@@ -591,7 +595,7 @@ n_classes), default=None
             :mod:`sklearn_crbm.layers` for their interface).
         """
         check_is_fitted(self)
-        return list(self._layers())
+        return list(self._fitted_layers())
 
     def fill_in_context(self, X, *, context=None, style=None):
         """What on-line fill-in of the frames ``X`` conditions on.
@@ -623,7 +627,7 @@ n_classes), default=None
 
     @property
     def _n_features_out(self):
-        return self._layers()[-1].n_components
+        return self._fitted_layers()[-1].n_components
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()

@@ -181,7 +181,7 @@ class BaseLayerModel(BaseCRBM):
         self._keep_seeds(X, sequences, merge=True, context=context)
         return self
 
-    def _layers(self):
+    def _fitted_layers(self):
         return [self._layer]
 
     def _planned_layers(self, n_features):

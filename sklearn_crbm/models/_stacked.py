@@ -280,7 +280,7 @@ class StackedCRBM(BaseCRBM):
         X = validate_data(
             self,
             X,
-            dtype=[xp.float64, xp.float32] if reset else self._layers()[0].dtype,
+            dtype=[xp.float64, xp.float32] if reset else self._fitted_layers()[0].dtype,
             reset=reset,
         )
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
@@ -412,7 +412,7 @@ class StackedCRBM(BaseCRBM):
         self._keep_seeds(X, sequences, merge=True)
         return self
 
-    def _layers(self):
+    def _fitted_layers(self):
         return [layer for model in self.layers_ for layer in model.conditional_layers()]
 
     def _planned_layers(self, n_features):

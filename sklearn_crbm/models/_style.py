@@ -331,7 +331,7 @@ class BaseStyleModel(BaseLayerModel):
         """A digest of everything :meth:`_posterior` depends on."""
         digest = hashlib.blake2b(digest_size=16)
         arrays = [X, sequences.starts, sequences.lengths]
-        arrays += [layer.flat for layer in self._layers()]
+        arrays += [layer.flat for layer in self._fitted_layers()]
         for array in arrays:
             array = np.ascontiguousarray(to_numpy(array))
             digest.update(f"{array.dtype}{array.shape}".encode())

@@ -1192,11 +1192,11 @@ def test_bad_styles(case, ctx):
 @pytest.mark.parametrize("key", [key for key, _ in STYLE_MODELS])
 def test_bad_styles_leave_a_fitted_model_as_it_was(key, ctx):
     model = copy.deepcopy(ctx.f[key])
-    before = model._layers()[0].flat.copy()
+    before = model._fitted_layers()[0].flat.copy()
     with pytest.raises(ValueError, match="not seen in fit"):
         model.partial_fit(ctx.X, np.full(ctx.n, "medium"), sequence_ids=ctx.ids)
     assert model.n_iter_ == ctx.f[key].n_iter_
-    np.testing.assert_array_equal(model._layers()[0].flat, before)
+    np.testing.assert_array_equal(model._fitted_layers()[0].flat, before)
     assert model.classes_.tolist() == ["high", "low"]
 
 

@@ -169,8 +169,8 @@ def test_style_models_stay_finite_on_cmu35(
     model = factories[key](**STYLE_SETTINGS[key], order=3, batch_size=100, ais_steps=10)
     with np.errstate(**TROUBLE):
         model.fit(X, y, sequence_ids=ids)
-        assert model._layers()[0].flat.dtype == dtype
-        assert np.isfinite(model._layers()[0].flat).all()
+        assert model._fitted_layers()[0].flat.dtype == dtype
+        assert np.isfinite(model._fitted_layers()[0].flat).all()
         assert model.reconstruction_error_ < 62  # better than the mean
         outputs = {
             "transform": model.transform(X, style=y, sequence_ids=ids),
@@ -325,7 +325,7 @@ def huge_style_models(fitted):
     rng = np.random.default_rng(0)
     for key in STYLE_MODELS:
         model = copy.deepcopy(fitted[key])
-        flat = model._layers()[0].flat
+        flat = model._fitted_layers()[0].flat
         flat[...] = 3e3 * rng.standard_normal(flat.shape)
         models[key] = model
     return models

@@ -141,7 +141,7 @@ def test_every_model_has_a_work_estimate(model):
     before = _product_size(batch_rows, model, (X, y), {})
     assert before >= model.batch_size * 4 * 5
     model.fit(X, y, sequence_ids=ids)
-    largest = max(layer.product_size() for layer in model._layers())
+    largest = max(layer.product_size() for layer in model._fitted_layers())
     assert _product_size(batch_rows, model, (X, y), {}) == model.batch_size * largest
     assert _product_size(frame_rows, model, (X,), {}) == len(X) * largest
     imputer = CRBMImputer(model).fit(X, y, sequence_ids=ids)
