@@ -113,6 +113,20 @@ def _forward_feature(names):
     return found[0]
 
 
+def frame_forward_speed(X, column):
+    """Forward speed of every frame, in length units per frame.
+
+    The package's one definition of forward speed: the body's ground
+    distance along its forward direction from each frame to the next,
+    which :class:`~sklearn_crbm.preprocessing.RootRelativeEncoder` writes to
+    its ``"{root}_dforward"`` channel, here column ``column`` of ``X``.
+    :func:`forward_speed` averages it over each sequence;
+    :class:`~sklearn_crbm.preprocessing.MotionContext` multiplies it by the
+    frame rate (length units per second) before smoothing.
+    """
+    return X[:, column]
+
+
 def _check_last_frames(last_frames):
     if last_frames is None:
         return None
@@ -191,10 +205,11 @@ def forward_speed(
     columns = _columns(feature, names, X.shape[1])
     if len(columns) != 1:
         raise ValueError("forward_speed needs exactly one feature.")
+    speeds = frame_forward_speed(X, columns[0])[:, None]
     return np.array(
         [
             segment[:, 0].mean()
-            for segment in _segments(X, sequences, columns, last_frames)
+            for segment in _segments(speeds, sequences, [0], last_frames)
         ]
     )
 

@@ -11,6 +11,7 @@ from sklearn.utils.validation import (
     validate_data,
 )
 
+from ..metrics._generation import frame_forward_speed
 from ..utils._persistence import VersionedPickleMixin
 from ..utils._sequences import check_sequence_ids
 from ._expmap import ExpMapEncoder
@@ -385,7 +386,13 @@ class MotionContext(VersionedPickleMixin, TransformerMixin, BaseEstimator):
             raw = X[:, self._raw_columns]
             root = self._expmap.transform(raw)[:, self._root_columns]
             X = self._root_encoder.transform(root, sequence_ids=sequence_ids)
-        rates = X[:, self._delta_columns] * self.frame_rate
+        per_frame = [
+            frame_forward_speed(X, column)
+            if signal == "forward_speed"
+            else X[:, column]
+            for signal, column in zip(self.signals, self._delta_columns, strict=True)
+        ]
+        rates = np.stack(per_frame, axis=1) * self.frame_rate
         return centred_moving_average(rates, sequences, self.window_frames_ // 2)
 
     def get_feature_names_out(self, input_features=None):

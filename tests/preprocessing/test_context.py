@@ -8,6 +8,7 @@ from sklearn.pipeline import make_pipeline
 from sklearn.utils._param_validation import InvalidParameterError
 
 from sklearn_crbm.datasets import Bone, Skeleton, load_cmu35
+from sklearn_crbm.metrics import forward_speed
 from sklearn_crbm.preprocessing import (
     ExpMapEncoder,
     MotionContext,
@@ -207,3 +208,22 @@ def test_cmu35_walks_are_slower_than_jogs(data_home):
     assert 0 < walk_speed < jog_speed
     # the trials go mostly straight
     assert np.abs(C[:, 1]).mean() < 0.5
+
+
+def test_forward_speed_is_the_metric_times_the_frame_rate():
+    # one definition of forward speed: MotionContext's signal (per second,
+    # unsmoothed with a one-frame window) is metrics.forward_speed's per-frame
+    # speed times the frame rate, frame by frame and on average
+    rng = np.random.default_rng(0)
+    X = rng.normal(size=(50, 3))  # plain deltas: dforward, dheading, dsideways
+    ids = np.repeat([0, 1], [20, 30])
+    context = MotionContext(
+        signals=["turning_rate", "forward_speed"], window=1 / 25, frame_rate=25.0
+    ).fit_transform(X, sequence_ids=ids)
+    np.testing.assert_allclose(context[:, 1], X[:, 0] * 25.0, rtol=1e-12, atol=1e-12)
+    per_sequence = [context[ids == k, 1].mean() for k in (0, 1)]
+    np.testing.assert_allclose(
+        np.array(per_sequence) / 25.0,
+        forward_speed(X, sequence_ids=ids, feature=0),
+        rtol=1e-12,
+    )
