@@ -276,19 +276,6 @@ def load_training_data(name, data_home, dtype=np.float64):
     return np.asarray(X, dtype=dtype), np.asarray(bunch.sequence_ids), source
 
 
-def style_folds(styles, trials, n_folds=3):
-    """Trials per fold: the k-th trial of every style goes to fold ``k % n_folds``.
-
-    ``styles`` gives the style of every trial; ``trials`` are the trials to
-    split, in trial order.  Every fold holds walks and jogs.
-    """
-    folds = [[] for _ in range(n_folds)]
-    for style in np.unique(styles[trials]):
-        for k, trial in enumerate(t for t in trials if styles[t] == style):
-            folds[k % n_folds].append(int(trial))
-    return folds
-
-
 # ------------------------------------------------------------- model cache
 # A fit runs the models' modules and utils/, never these (nor the packages'
 # __init__ files, which only re-export): they are left out of the cache key,

@@ -202,8 +202,9 @@ fig.savefig(OUTPUT / "model_selection.png", dpi=90)
 # the log-likelihood rises by tens of nats.  Within an order the agreement is
 # looser.  Here (one fold, 100 epochs, the left leg only) more hidden units
 # fill the leg slightly better while the likelihood prefers fewer.  Over the
-# grid of ``benchmarks/model_selection.py`` (3 folds, both body parts, 16
-# configurations, 500 epochs, the imputer's defaults) the rank correlation
+# grid of ``benchmarks/model_selection.py`` (in the git history at b32d7fc;
+# 3 folds, both body parts, 16 configurations, 500 epochs, the imputer's
+# defaults) the rank correlation
 # between the score and minus the fill-in error among the models with history
 # is 0.73 when they are trained on clean histories (``history_noise=0``) and
 # 0.08 to 0.11 with the default noisy histories: their hidden units carry the
