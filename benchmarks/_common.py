@@ -1,15 +1,10 @@
 """What the benchmark scripts share; not part of the package.
 
-Options and paths, the package under test and the machine, data (the splits
-of CMU subject 35, synthetic motion), one cache of fitted models keyed on the
-package's code, the bootstrap of a mean over training seeds, timing, tables
-and JSON.  The scripts import this module and the package's public API, and
-nothing else of the package: the one exception, the matrix products of a
-training epoch timed on their own, is marked below.
-
-The package under test is the one Python imports: set ``PYTHONPATH`` to
-another checkout to measure its code with these scripts (every script prints
-which one it measures, and writes it into its JSON).
+Options and paths, the package under test (the one Python imports: set
+``PYTHONPATH``) and the machine, data (CMU 35's splits, synthetic motion),
+the cache of fitted models, the bootstrap over training seeds, timing,
+tables and JSON.  The scripts import this module and the package's public
+API only.
 """
 
 import argparse

@@ -1,17 +1,21 @@
-"""Generation speed of ConditionalRBM.sample: 1 sequence and many together.
+"""Generation and fill-in speed of the paper's model: ``sample`` and ``CRBMImputer``.
 
 The paper's model size (62 dimensions, 200 hidden units, order 3), trained
-briefly on CMU subject 35 (speed does not depend on how well it is trained),
-generates ``--n-frames`` new frames with 30 alternating Gibbs steps per frame
-(the original code's scheme), for 1 sequence and for ``--n-sequences``
-sequences together, in float64 and float32, with one BLAS thread.  The same
-scheme written as a straightforward vectorised numpy loop is timed in the
-same run ("x naive"); "x real time" is against 30 frames per second.
+briefly on CMU subject 35 (speed does not depend on how well it is
+trained), float64 and float32, one BLAS thread; "x real time" is against
+30 frames per second.  ``--parts``:
 
-Run from the repository root (about a minute)::
+- ``generate``: ``--n-frames`` new frames, 30 Gibbs steps per frame (the
+  original code's scheme), for 1 and ``--n-sequences`` sequences together,
+  against the same scheme as a straightforward numpy loop ("x naive");
+- ``fillin``: ``CRBMImputer`` at its defaults (20 particles per draw) fills
+  the left leg or the upper body of the paper split's two test trials,
+  erased in every frame, on-line, for ``--n-draws`` averaged draws.
+
+Run from the repository root (about two minutes)::
 
     python benchmarks/bench_generate.py
-    python benchmarks/bench_generate.py --n-frames 400 --repeats 7
+    python benchmarks/bench_generate.py --parts fillin --n-draws 1 10
 """
 
 from functools import partial
@@ -20,6 +24,7 @@ import numpy as np
 from _common import (
     PAPER,
     REAL_TIME_FPS,
+    Split,
     announce,
     load_training_data,
     print_table,
@@ -32,6 +37,8 @@ from _common import (
 from scipy.special import expit
 
 from sklearn_crbm import ConditionalRBM
+from sklearn_crbm.impute import CRBMImputer
+from sklearn_crbm.model_selection import erasure_mask, paper_body_parts
 
 
 def naive_generate(model, seed, n_samples, n_gibbs, random_state):
@@ -54,13 +61,7 @@ def naive_generate(model, seed, n_samples, n_gibbs, random_state):
     return np.stack(frames[seed.shape[1] :], axis=1)
 
 
-def main(argv=None):
-    p = speed_parser(__doc__, threads=(1,))
-    p.add_argument("--n-frames", type=int, default=100, help="new frames per sequence")
-    p.add_argument("--n-sequences", type=int, nargs="+", default=[1, 100])
-    p.add_argument("--n-gibbs", type=int, default=30)
-    args = p.parse_args(argv)
-    announce()
+def generation(args):
     X, ids, source = load_training_data("cmu35", args.data_home)
     rows = []
     for dtype in args.dtypes:
@@ -116,8 +117,74 @@ def main(argv=None):
         ],
         title="\nGeneration, 62-200 order 3",
     )
-    payload = dict(args=vars(args), data=source, rows=rows, table=table)
-    write_json("bench_generate", args.output, **payload)
+    return dict(data=source, rows=rows, table=table)
+
+
+def fillin(args):
+    split = Split(args.data_home, "paper")
+    names = split.preprocessor.get_feature_names_out()
+    masks = {
+        part: erasure_mask(
+            split.X_test, bones=bones, feature_names=names, start=0, strict=False
+        )
+        for part, bones in paper_body_parts(split.cmu.skeleton).items()
+    }
+    rows = []
+    for dtype in args.dtypes:
+        model = ConditionalRBM(PAPER["n_components"], order=PAPER["order"], n_iter=20)
+        for threads, n_draws in ((t, n) for t in args.threads for n in args.n_draws):
+            imputer = CRBMImputer(model, n_draws=n_draws, random_state=0)
+            imputer.fit(split.X_train.astype(dtype), sequence_ids=split.train_ids)
+            for part, mask in masks.items():
+                X = np.where(mask, np.nan, split.X_test).astype(dtype)
+                ids = split.test_ids
+                fill = partial(imputer.transform, X, sequence_ids=ids)
+                with threadpool_limits(threads):
+                    imputer.transform(X[:20], sequence_ids=ids[:20])  # warm up
+                    times = [seconds(fill) for _ in range(args.repeats)]
+                rows.append(
+                    dict(
+                        dtype=dtype,
+                        threads=threads,
+                        missing=part,
+                        channels=int(mask.any(axis=0).sum()),
+                        n_draws=n_draws,
+                        frames=len(X),
+                        seconds=min(times),
+                        frames_per_s=len(X) / min(times),
+                        x_real_time=len(X) / min(times) / REAL_TIME_FPS,
+                        times=summary(times),
+                    )
+                )
+    table = print_table(
+        rows,
+        [
+            *("dtype", "threads", "missing", "channels"),
+            ("n_draws", "draws", "d"),
+            "frames",
+            ("seconds", "seconds (best)", ".3f"),
+            ("frames_per_s", "frames/s", ",.0f"),
+            ("x_real_time", "x real time", ",.1f"),
+        ],
+        title="\nFill-in with CRBMImputer's defaults, 62-200 order 3",
+    )
+    return dict(rows=rows, table=table)
+
+
+def main(argv=None):
+    p = speed_parser(__doc__, threads=(1,))
+    p.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
+    p.add_argument("--n-frames", type=int, default=100, help="new frames per sequence")
+    p.add_argument("--n-sequences", type=int, nargs="+", default=[1, 100])
+    p.add_argument("--n-gibbs", type=int, default=30)
+    p.add_argument("--n-draws", type=int, nargs="+", default=[1, 10])
+    args = p.parse_args(argv)
+    announce()
+    results = {part: PARTS[part](args) for part in args.parts}
+    write_json("bench_generate", args.output, args=vars(args), **results)
+
+
+PARTS = {"generate": generation, "fillin": fillin}
 
 
 if __name__ == "__main__":

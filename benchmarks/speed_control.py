@@ -74,15 +74,10 @@ class SpeedTask:
             [np.full(RAMP[0], walk), rising, np.full(RAMP[2], jog)]
         )
 
-    def context(self, speed):
-        """What the model is given for speeds ``(n_frames, 1)``."""
-        speed = np.asarray(speed, dtype=float).reshape(-1, 1)
-        return speed
-
     def fit(self, seed, model_params):
         """``(model, fit seconds)``: the model trained with every frame's speed."""
         model = ConditionalRBM(random_state=seed, **model_params)
-        context = self.context(self.speeds)
+        context = np.asarray(self.speeds, dtype=float).reshape(-1, 1)
         return cached_fit(model, self.corpus.Z, self.corpus.ids, context=context)
 
     def generate(self, model, history, speed, seed):
@@ -93,7 +88,7 @@ class SpeedTask:
             Z = model.sample(
                 N_FRAMES,
                 history=history,
-                context=self.context(speed),
+                context=np.asarray(speed, dtype=float).reshape(-1, 1),
                 random_state=seed,
             )
         ids = np.repeat(np.arange(n), N_FRAMES)

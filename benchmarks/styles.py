@@ -411,25 +411,11 @@ def _fillin(rows, rng):
     return _interval([[ratio] for row in rows for ratio in row], None, rng, False)
 
 
-def _lowest_style(rows):
-    """The style whose mean share kept and alive over the seeds is lowest."""
-    means = {}
-    for result in rows:
-        for style, cell in result.items():
-            means.setdefault(style, []).append(cell["kept_alive"])
-    style = min(means, key=lambda s: np.mean(means[s]))
-    return f"{style} {100 * np.mean(means[style]):.0f}%"
-
-
 def _pace(rows):
     cells = [cell for row in rows for cell in row]
     passed = sum(c["pace_ok"] for c in cells)
     total = sum(len(c["amplitude_ratio"]) for c in cells)
     return f"{passed}/{total}"
-
-
-def _blown_up_total(rows):
-    return str(sum(cell["blown_up"] for row in rows for cell in row))
 
 
 def _blends(rows, rng):
@@ -462,15 +448,8 @@ def _recognition(rows):
     return f"{min(correct)}-{max(correct)}/{rows[0][0]['of']}"
 
 
-def _batch(rows):
-    cells = [row[0] for row in rows if "generation_of_products_bound" in row[0]]
-    if not cells:
-        return "-"
-    return f"{np.mean([c['generation_of_products_bound'] for c in cells]):.2f}"
-
-
-def _epoch(rows):
-    return f"{np.mean([row[0]['seconds_per_epoch'] for row in rows]):.2f}"
+def _mean(rows, key):
+    return f"{np.mean([row[0][key] for row in rows]):.2f}"
 
 
 # (column, part, formatter of the per-seed rows of cells; ``rng`` for the
@@ -483,7 +462,7 @@ COLUMNS = [
         lambda r, g: f"{100 * np.mean([c['kept'] for x in r for c in x]):.0f}%",
     ),
     ("in pace", "style", lambda r, g: _pace(r)),
-    ("blown up", "style", lambda r, g: _blown_up_total(r)),
+    ("blown up", "style", lambda r, g: str(sum(c["blown_up"] for x in r for c in x))),
     (
         "transitions: new & alive [95%]",
         "transitions",
@@ -497,8 +476,12 @@ COLUMNS = [
     ("held-out LL/frame", "likelihood", lambda r, g: _likelihood(r)),
     ("recognised", "recognition", lambda r, g: _recognition(r)),
     ("fill-in log ratio [95%]", "fillin", lambda r, g: _fillin(r, g)),
-    ("100 together / products", "speed", lambda r, g: _batch(r)),
-    ("s/epoch", "speed", lambda r, g: _epoch(r)),
+    (
+        "100 together / products",
+        "speed",
+        lambda r, g: _mean(r, "generation_of_products_bound"),
+    ),
+    ("s/epoch", "speed", lambda r, g: _mean(r, "seconds_per_epoch")),
 ]
 
 
@@ -507,15 +490,19 @@ def table(results, seed=0):
     share kept and alive per style."""
     row = {"seeds": ",".join(str(s) for s in results)}
     styles = [r["style"] for r in results.values() if r.get("style")]
-    row["lowest style"] = _lowest_style(styles) if styles else "-"
+    means = {
+        s: np.mean([r[s]["kept_alive"] for r in styles])
+        for s in (styles[0] if styles else ())
+    }
+    lowest = min(means, key=means.get) if means else None
+    row["lowest style"] = f"{lowest} {100 * means[lowest]:.0f}%" if means else "-"
     for column, part, formatter in COLUMNS:
         cells = _per_seed(results, part)
         # each column its own stream: its interval does not depend on the
         # columns before it
         row[column] = formatter(cells, np.random.default_rng(seed)) if cells else "-"
     print_table([row], list(row))
-    if styles:
-        means = {s: np.mean([r[s]["kept_alive"] for r in styles]) for s in styles[0]}
+    if means:
         print()
         print_table([{s: f"{100 * m:.0f}%" for s, m in means.items()}], list(means))
 
