@@ -458,7 +458,9 @@ def test_only_the_runs_of_sequence_ids_matter(
     reference = factories[key]().fit(X, *style_args, sequence_ids=ids)
     for other_ids in (relabelled, as_floats):
         model = factories[key]().fit(X, *style_args, sequence_ids=other_ids)
-        assert_array_equal(model._fitted_layers()[0].flat, reference._fitted_layers()[0].flat)
+        assert_array_equal(
+            model._fitted_layers()[0].flat, reference._fitted_layers()[0].flat
+        )
 
 
 @settings(max_examples=25, **SETTINGS)
