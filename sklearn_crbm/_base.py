@@ -57,6 +57,10 @@ __all__ = [
 MAX_SEED_WINDOWS = 500
 # Gibbs iterations per generated frame of a model without an ``n_gibbs``.
 DEFAULT_N_GIBBS = 30
+# What sample does for a model without the parameters n_mean_field and
+# hidden_drift (a layer model defined outside the package).
+DEFAULT_N_MEAN_FIELD = 10
+DEFAULT_HIDDEN_DRIFT = 0.0
 # Mean-field iterations of the one-step-ahead prediction (``predict_next``).
 SCORE_MEAN_FIELD_STEPS = 10
 # Annealing of ``score`` for a model without ``ais_steps``/``ais_chains``.
@@ -119,15 +123,14 @@ class BaseCRBM(
         "batching": [StrOptions({"balanced", "shuffled"})],
         "history_noise": [Interval(Real, 0, None, closed="left")],
         "n_iter": [Interval(Integral, 1, None, closed="left"), StrOptions({"auto"})],
+        "n_mean_field": [Interval(Integral, 1, None, closed="left")],
+        "hidden_drift": [Interval(Real, 0, None, closed="left")],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
     }
 
     # Noise on the previous frame where a new frame's Gibbs chain starts.
     _start_jitter = START_JITTER
-
-    # Mean-field steps that end a generated frame unless sample is told.
-    _n_mean_field = 10
 
     # With sklearn.set_config(enable_metadata_routing=True) a Pipeline or a
     # search passes ``sequence_ids`` and ``context`` to these methods without
@@ -136,6 +139,17 @@ class BaseCRBM(
     __metadata_request__partial_fit = {"sequence_ids": True, "context": True}
     __metadata_request__transform = {"sequence_ids": True, "context": True}
     __metadata_request__score = {"sequence_ids": True, "context": True}
+
+    def __setstate__(self, state):
+        # Models pickled before sample's settings became parameters sampled
+        # with the class's default mean-field steps and no drift.
+        state = dict(state)
+        parameters = inspect.signature(type(self).__init__).parameters
+        if "n_mean_field" in parameters and "n_mean_field" not in state:
+            state["n_mean_field"] = parameters["n_mean_field"].default
+        if "hidden_drift" in parameters:
+            state.setdefault("hidden_drift", 0.0)
+        super().__setstate__(state)
 
     # ---------------------------------------------------------------- hooks
 
@@ -749,6 +763,7 @@ n_classes), default=None
         hidden_noise=0.0,
         sample_visibles=False,
         n_mean_field=None,
+        hidden_drift=None,
         random_state=None,
         n_jobs=None,
     ):
@@ -757,11 +772,14 @@ n_classes), default=None
         Each new frame starts from the previous frame plus N(0, 0.01^2)
         jitter; ``n_gibbs`` alternating Gibbs iterations follow (hidden units
         sampled, visibles set to their mean), then ``n_mean_field``
-        mean-field steps (hidden probabilities, visible means).  All
-        sequences are generated together.  A stack does this in its top
-        layer, whose visible units are the hidden probabilities of the layer
-        below, and each layer below turns them into its visible means given
-        its own generated past, down to the data (Taylor's ``gen2.m``).
+        mean-field steps (hidden probabilities, visible means).  With
+        ``hidden_drift``, every sequence's hidden biases carry a random
+        offset that changes smoothly from frame to frame and holds through
+        all of a frame's steps.  All sequences are generated together.  A
+        stack does this in its top layer, whose visible units are the hidden
+        probabilities of the layer below, and each layer below turns them
+        into its visible means given its own generated past, down to the
+        data (Taylor's ``gen2.m``).
 
         Parameters
         ----------
@@ -804,12 +822,12 @@ default=None
             motion.
         n_mean_field : int, default=None
             Mean-field steps that end each frame (ignored with
-            ``sample_visibles``).  The original code takes one, which leaves
-            the frame where the last sampled hidden states put it, and the
-            frames shake; further steps settle it at the mean-field fixed
-            point of the mode the chain ended in.  None: 10, or 1 for the
-            style models, where ten settle a blend of two styles into one
-            gait.
+            ``sample_visibles``); None: the model's ``n_mean_field``
+            parameter.
+        hidden_drift : float, default=None
+            Standard deviation of the smooth random offset of the (top
+            layer's) hidden biases that keeps sequences apart; None: the
+            model's ``hidden_drift`` parameter.
         random_state : int, RandomState instance or None, default=None
             Seeds the generation; ``None`` uses the estimator's
             ``random_state``, so repeated calls give the same frames when
@@ -831,13 +849,20 @@ default=None
         """
         check_is_fitted(self)
         n_samples = check_count(n_samples, "n_samples", minimum=1)
+        params = self.get_params()
         if n_gibbs is None:
-            n_gibbs = self.get_params().get("n_gibbs", DEFAULT_N_GIBBS)
+            n_gibbs = params.get("n_gibbs", DEFAULT_N_GIBBS)
         n_gibbs = check_count(n_gibbs, "n_gibbs", minimum=0)
         n_sequences = check_count(n_sequences, "n_sequences", minimum=1)
         if n_mean_field is None:
-            n_mean_field = self._n_mean_field
+            n_mean_field = params.get("n_mean_field", DEFAULT_N_MEAN_FIELD)
         n_mean_field = check_count(n_mean_field, "n_mean_field", minimum=1)
+        if hidden_drift is None:
+            hidden_drift = params.get("hidden_drift", DEFAULT_HIDDEN_DRIFT)
+        if not isinstance(hidden_drift, Real) or not hidden_drift >= 0:
+            raise ValueError(
+                f"hidden_drift must be a non-negative number, got {hidden_drift!r}."
+            )
         if not isinstance(hidden_noise, Real) or not hidden_noise >= 0:
             raise ValueError(
                 f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
@@ -870,6 +895,7 @@ default=None
             hidden_noise=hidden_noise,
             sample_visibles=sample_visibles,
             n_mean_field=n_mean_field,
+            hidden_drift=hidden_drift,
             n_jobs=n_jobs,
         )
         self._check_generated(frames, n_samples, labels)
@@ -906,7 +932,8 @@ default=None
         ``seed`` has shape ``(n_sequences, width, n_features)``; ``context``
         (shape ``(n_sequences, n_samples, n_context)``) gives each new frame's
         context to a layer that takes one.  ``gibbs`` holds ``n_gibbs``,
-        ``hidden_noise``, ``sample_visibles`` and ``n_mean_field``.
+        ``hidden_noise``, ``sample_visibles``, ``n_mean_field`` and
+        ``hidden_drift``.
         """
         layers = self._layers()
         ops = layers[0].ops
