@@ -110,7 +110,7 @@ class ConditionalRBM(BaseLayerModel):
         mean-field fixed point of the mode the chain ended in: smooth, but
         deterministic given the past, so that without ``hidden_drift``
         sequences generated from one seed become copies of each other.
-    hidden_drift : float, default=0.35
+    hidden_drift : float, default=0.3
         Standard deviation of a random offset of the hidden biases of every
         sequence :meth:`sample` generates, which changes smoothly over a
         few frames and holds through all of a frame's steps: randomness that
@@ -240,7 +240,7 @@ class ConditionalRBM(BaseLayerModel):
         validation_interval=10,
         tol=1e-3,
         n_mean_field=10,
-        hidden_drift=0.35,
+        hidden_drift=0.3,
         random_state=None,
         verbose=0,
     ):

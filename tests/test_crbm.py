@@ -498,7 +498,7 @@ def test_sampler_settings_are_parameters():
         X, sequence_ids=ids
     )
     assert model.get_params()["n_mean_field"] == 10
-    assert model.get_params()["hidden_drift"] == 0.35
+    assert model.get_params()["hidden_drift"] == 0.3
     given = dict(n_sequences=2, random_state=0)
     by_keyword = model.sample(10, n_mean_field=1, hidden_drift=0.0, **given)
     model.set_params(n_mean_field=1, hidden_drift=0.0)
