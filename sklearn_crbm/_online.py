@@ -483,8 +483,8 @@ def _drift_step(drift, like, rng, std, frames=None):
     """
     frames = DRIFT_FRAMES if frames is None else frames
     a = math.exp(-1.0 / frames)
-    # z's variance is (1 - a)^2 gain^2 std^2 (1 + a^2) / (1 - a^2)^2
-    gain = math.sqrt((1 - a * a) / ((1 - a) ** 2 * (1 + a * a) / (1 - a * a)))
+    # z's variance is (1 - a)^2 gain^2 std^2 (1 + a^2) / (1 - a^2)^2: std^2
+    gain = (1 + a) / math.sqrt(1 + a * a)
     shape, dtype = like.shape, like.dtype
     if drift is None:
         u = rng.standard_normal(shape, dtype=dtype)
