@@ -1341,7 +1341,8 @@ def _styles_asked(labels, label_names):
     weights = to_numpy(labels)[-LIVELINESS_FRAMES:].mean(axis=0)
     asked = np.flatnonzero(weights > 0)
     asked = asked[np.argsort(-weights[asked], kind="stable")]
-    names = [repr(np.asarray(label_names)[k].item()) for k in asked]
+    names = [np.asarray(label_names)[k] for k in asked]
+    names = [repr(n.item() if isinstance(n, np.generic) else n) for n in names]
     if len(asked) == 1:
         return f" ({names[0]})"
     weighted = (f"{n} {weights[k]:.2f}" for n, k in zip(names, asked, strict=True))

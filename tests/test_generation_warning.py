@@ -232,10 +232,9 @@ def test_a_slow_style_is_judged_against_its_own_takes(oscillations):
     message = lifeless_message(slow_takes, 150, stats, labels=fast)
     assert "Sequences 0, 1 of 2 died out" in message
     assert "as the training sequences of the style asked for" in message
-    named = lifeless_message(
-        slow_takes, 150, stats, labels=fast, label_names=np.array(["fast", "slow"])
-    )
-    assert "of the style asked for ('fast')" in named
+    for names in (np.array(["fast", "slow"]), np.array(["fast", "slow"], object)):
+        named = lifeless_message(slow_takes, 150, stats, labels=fast, label_names=names)
+        assert "of the style asked for ('fast')" in named
     blend = lifeless_message(
         slow_takes,
         150,
