@@ -26,6 +26,7 @@ from sklearn.preprocessing import StandardScaler
 from sklearn_crbm import ConditionalRBM, TrainingDivergedError
 from sklearn_crbm.datasets import load_cmu35, make_oscillations
 from sklearn_crbm.layers._crbm import CRBMFrames
+from sklearn_crbm.metrics import divergence
 from sklearn_crbm.model_selection import make_prediction_scorer
 from sklearn_crbm.utils._random import rng_from, standard_normal, uniform
 from sklearn_crbm.utils._sequences import balanced_batches, frame_history
@@ -457,13 +458,56 @@ def test_sample_settles_each_frame_by_mean_field():
     def jerk(frames):
         return np.abs(np.diff(frames, 3, axis=0)).mean()
 
-    original = model.sample(40, history=X[:3], n_mean_field=1, random_state=1)
-    settled = model.sample(40, history=X[:3], random_state=1)
+    given = dict(history=X[:3], hidden_drift=0.0, random_state=1)
+    original = model.sample(40, n_mean_field=1, **given)
+    settled = model.sample(40, **given)
     assert jerk(original) > jerk(X[:80]) > 5 * jerk(settled)
     assert np.std(settled, axis=0).min() > 0.3
     assert_allclose(np.std(settled, axis=0), np.std(original, axis=0), rtol=0.05)
     with pytest.raises(ValueError, match="n_mean_field must be an integer >= 1"):
         model.sample(3, n_mean_field=0)
+
+
+def test_hidden_drift_keeps_sequences_from_one_seed_apart_and_smooth():
+    """Without drift, the mean-field steps make sequences from one seed
+    copies; the drift parts them without bringing back the shake of one
+    step."""
+    X, ids = make_oscillations(n_sequences=6, n_frames=80, n_features=5, random_state=0)
+    model = ConditionalRBM(30, order=3, n_iter=150, learning_rate=0.01, random_state=0)
+    model.fit(X, sequence_ids=ids)
+    seed = np.repeat(X[None, :3], 4, axis=0)
+    sequence_ids = np.repeat(np.arange(4), 200)
+
+    def jerk(frames):
+        return np.abs(np.diff(frames, 3, axis=0)).mean()
+
+    copies = model.sample(200, history=seed, hidden_drift=0.0, random_state=1)
+    apart = model.sample(200, history=seed, random_state=1)  # the default drift
+    shaky = model.sample(200, history=seed, n_mean_field=1, hidden_drift=0.0)
+    assert divergence(copies, sequence_ids=sequence_ids, frames=slice(100, 200)) < 0.1
+    assert divergence(apart, sequence_ids=sequence_ids, frames=slice(100, 200)) > 0.3
+    assert jerk(shaky) > 3 * jerk(apart)
+    assert np.std(apart, axis=0).min() > 0.3
+
+
+def test_sampler_settings_are_parameters():
+    """set_params (a search, a pipeline) sets what sample does by default;
+    sample's keywords still override it."""
+    X, ids = make_oscillations(n_frames=40, n_features=5, random_state=0)
+    model = ConditionalRBM(8, order=2, n_iter=5, random_state=0).fit(
+        X, sequence_ids=ids
+    )
+    assert model.get_params()["n_mean_field"] == 10
+    assert model.get_params()["hidden_drift"] == 0.3
+    given = dict(n_sequences=2, random_state=0)
+    by_keyword = model.sample(10, n_mean_field=1, hidden_drift=0.0, **given)
+    model.set_params(n_mean_field=1, hidden_drift=0.0)
+    assert_array_equal(model.sample(10, **given), by_keyword)
+    assert not np.allclose(model.sample(10, hidden_drift=1.0, **given), by_keyword)
+    with pytest.raises(ValueError, match="hidden_drift must be a non-negative"):
+        model.sample(3, hidden_drift=-1.0)
+    with pytest.raises(ValueError, match="n_mean_field"):
+        ConditionalRBM(n_mean_field=0).fit(X, sequence_ids=ids)
 
 
 def test_hidden_noise_changes_samples():
@@ -473,8 +517,10 @@ def test_hidden_noise_changes_samples():
     )
     # one mean-field step: the many of the default settle every chain of a
     # 5-epoch model at the same point, noise or not
-    quiet = model.sample(10, n_mean_field=1, random_state=0)
-    noisy = model.sample(10, hidden_noise=1.0, n_mean_field=1, random_state=0)
+    quiet = model.sample(10, n_mean_field=1, hidden_drift=0.0, random_state=0)
+    noisy = model.sample(
+        10, hidden_noise=1.0, n_mean_field=1, hidden_drift=0.0, random_state=0
+    )
     assert not np.allclose(quiet, noisy)
 
 

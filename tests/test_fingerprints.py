@@ -43,7 +43,8 @@ X_MISSING[25:28] = np.nan  # wholly missing frames
 # fingerprints were computed with clean histories; so is
 # history_noise_fraction where there is noise (its default changed later),
 # and average_fraction (added later with a default that averages); so is
-# sample's n_mean_field (its default became 10 mean-field steps later).
+# sample's n_mean_field (its default became 10 mean-field steps later) and
+# hidden_drift (added later, on by default).
 MODELS = {
     "order2": dict(n_components=8, order=2, history_noise=0.0),
     "order3_hidden1": dict(n_components=6, order=3, hidden_order=1, history_noise=0.0),
@@ -90,7 +91,12 @@ def _crbm_results():
             model.partial_fit(X[IDS < 2].astype(dtype), sequence_ids=IDS[IDS < 2])
             out.update(_fitted(f"partial_fit.{name}.{dtype}", model))
             out[f"sample.{name}.{dtype}"] = model.sample(
-                12, n_sequences=3, n_gibbs=5, n_mean_field=1, random_state=1
+                12,
+                n_sequences=3,
+                n_gibbs=5,
+                n_mean_field=1,
+                hidden_drift=0.0,
+                random_state=1,
             )
         model = _crbm("order2", dtype)
         key = f"order2.{dtype}"
@@ -104,10 +110,16 @@ def _crbm_results():
             n_gibbs=4,
             hidden_noise=0.3,
             n_mean_field=1,
+            hidden_drift=0.0,
             random_state=2,
         )
         out[f"sample_visibles.{key}"] = model.sample(
-            10, history=X[:5], n_sequences=2, sample_visibles=True, random_state=3
+            10,
+            history=X[:5],
+            n_sequences=2,
+            sample_visibles=True,
+            hidden_drift=0.0,
+            random_state=3,
         )
     binary = ConditionalRBM(
         5,
@@ -121,7 +133,7 @@ def _crbm_results():
     binary.fit((X > 0).astype(float), sequence_ids=IDS)
     out.update(_fitted("fit.binary.float64", binary))
     out["sample.binary.float64"] = binary.sample(
-        8, n_sequences=2, n_mean_field=1, random_state=0
+        8, n_sequences=2, n_mean_field=1, hidden_drift=0.0, random_state=0
     )
     return out
 
@@ -180,6 +192,7 @@ def _stacked_results():
                 n_gibbs=5,
                 hidden_noise=0.2,
                 n_mean_field=1,
+                hidden_drift=0.0,
                 random_state=1,
             )
             out[f"stack.transform.{key}"] = stack.transform(X, sequence_ids=IDS)

@@ -232,6 +232,17 @@ def test_a_slow_style_is_judged_against_its_own_takes(oscillations):
     message = lifeless_message(slow_takes, 150, stats, labels=fast)
     assert "Sequences 0, 1 of 2 died out" in message
     assert "as the training sequences of the style asked for" in message
+    for names in (np.array(["fast", "slow"]), np.array(["fast", "slow"], object)):
+        named = lifeless_message(slow_takes, 150, stats, labels=fast, label_names=names)
+        assert "of the style asked for ('fast')" in named
+    blend = lifeless_message(
+        slow_takes,
+        150,
+        stats,
+        labels=np.array([[0.75, 0.25]]),
+        label_names=np.array(["fast", "slow"]),
+    )
+    assert "of the style asked for ('fast' 0.75, 'slow' 0.25)" in blend
     # a blend is judged against the mean of its styles' amplitudes
     half = reference_amplitude(stats, np.full((1, 2), 0.5))
     assert half == pytest.approx(stats.label_amplitude.mean())
@@ -260,7 +271,7 @@ def test_partial_fit_joins_each_styles_amplitude(oscillations):
 def test_sample_judges_a_style_model_by_the_style_asked_for(oscillations):
     X, ids, styles = _slow_and_fast(oscillations)
     model = FactoredCRBM(n_iter=5, random_state=0).fit(X, styles, sequence_ids=ids)
-    with pytest.warns(GenerationWarning, match="of the style asked for"):
+    with pytest.warns(GenerationWarning, match=r"of the style asked for \('fast'\)"):
         model.sample(LIVELINESS_FRAMES, style="fast", n_sequences=2, random_state=0)
 
 

@@ -10,10 +10,12 @@ from numpy.testing import assert_allclose, assert_array_equal
 from sklearn_crbm import ConditionalRBM, StackedCRBM
 from sklearn_crbm._engines._gibbs import gibbs_frames
 from sklearn_crbm._engines._online import (
+    DRIFT_FRAMES,
     TOP_LAYER,
     WHOLE_STACK,
     History,
     Observed,
+    _drift_step,
     run_online,
 )
 from sklearn_crbm.datasets import make_oscillations
@@ -174,3 +176,21 @@ def test_fitted_attributes_view_the_packed_parameters():
     with pytest.raises(ValueError, match=r"components_ has shape \(5, 6\)"):
         model.components_ = np.zeros((4, 6))
     assert not hasattr(ConditionalRBM(), "components_")
+
+
+def test_drift_is_smooth_with_the_spread_asked():
+    """The hidden drift has the standard deviation asked for, decorrelates
+    over about DRIFT_FRAMES frames, and changes smoothly from frame to frame."""
+    rng = np.random.default_rng(0)
+    like = np.zeros((400, 50))
+    drift, values = None, []
+    for _ in range(300):
+        drift = _drift_step(drift, like, rng, 0.5)
+        values.append(drift[1])
+    z = np.array(values[100:])  # (frames, chains, units)
+    assert z.std() == pytest.approx(0.5, rel=0.05)
+    lag = DRIFT_FRAMES
+    correlation = np.mean(z[lag:] * z[:-lag]) / z.var()
+    assert 0.3 < correlation < 0.9
+    # far smoother than white noise of the same spread (third difference 0.5 sqrt(20))
+    assert np.diff(z, 3, axis=0).std() < 0.1 * 0.5 * np.sqrt(20)

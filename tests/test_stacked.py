@@ -223,7 +223,10 @@ def test_sample_is_top_down_as_gen2():
             np.random.RandomState(7).randint(np.iinfo(np.int32).max)
         ).integers(np.iinfo(np.int32).max)
     )
-    H_new = top.sample(6, history=H_seed, n_gibbs=3, random_state=rng_seed)
+    # (the stack has no drift; the top layer alone would have its default)
+    H_new = top.sample(
+        6, history=H_seed, n_gibbs=3, hidden_drift=0.0, random_state=rng_seed
+    )
     # Down: visible means of the bottom layer given its own generated past.
     past = list(seed[2:])
     for t in range(6):

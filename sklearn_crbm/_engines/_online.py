@@ -20,6 +20,7 @@ masked, never scattered, so nothing is indexed on a device but whole axes.
 gives the frame RBMs of the next frame.
 """
 
+import math
 from dataclasses import dataclass
 from numbers import Real
 
@@ -43,6 +44,10 @@ __all__ = [
     "collect_fills",
     "run_online",
 ]
+
+# Frames over which the random offset of hidden_drift persists (0.17 s at
+# 30 frames per second).
+DRIFT_FRAMES = 5
 
 # How a stack draws a frame (``scheme`` of run_online).  With one layer the two
 # are the same alternating Gibbs run of that layer.
@@ -304,6 +309,7 @@ def run_online(
     n_mean_field=1,
     offset_shrinkage=None,
     observation_gain=1.0,
+    hidden_drift=0.0,
 ):
     """Draw frames one after another, each given the chains' own past.
 
@@ -359,6 +365,11 @@ def run_online(
     n_mean_field : int, default=1
         Mean-field steps that end each frame's Gibbs run in
         :func:`gibbs_frames` (not with :data:`WHOLE_STACK` on a stack).
+    hidden_drift : float, default=0.0
+        Generation only: standard deviation of a smooth random offset of
+        each chain's (top) hidden biases, which persists over about
+        :data:`DRIFT_FRAMES` frames (:func:`_drift_step`) and holds through
+        the whole Gibbs run of a frame, mean-field steps included.
     offset_shrinkage : float, default=None
         Fill-in only.  ``None``: no correction.  A number ``lam >= 0``: each
         chain's drawn entries are shifted by the chain's :class:`Offsets`
@@ -424,10 +435,14 @@ def run_online(
     ops = layers[0].ops
     if observed is None:
         level = len(layers) - 1 if scheme == TOP_LAYER else 0
+        drift = None
         for step in range(n_steps):
             stack = history.frame_rbms(
                 None if context is None else context[:, step, ...]
             )
+            if hidden_drift:
+                drift = _drift_step(drift, stack[-1].hidden_bias, rng, hidden_drift)
+                stack[-1].hidden_bias = stack[-1].hidden_bias + drift[1]
             start = history.previous(level)
             if start_jitter:
                 start = start + start_jitter * rng.standard_normal(
@@ -450,6 +465,32 @@ def run_online(
         offset_shrinkage=offset_shrinkage,
         observation_gain=observation_gain,
     )
+
+
+def _drift_step(drift, like, rng, std, frames=None):
+    """The next value of a smooth random offset of the hidden biases.
+
+    Two first-order low-pass filters in a row (``a = exp(-1 / frames)``,
+    default :data:`DRIFT_FRAMES`) turn white noise into a process of
+    standard deviation ``std`` whose correlation decays over about
+    ``frames`` frames and whose steps are small and smooth: ``u`` is a
+    unit-variance Ornstein-Uhlenbeck process, ``z`` its low-pass.
+    ``drift`` is the state ``(u, z)``, None at the start (both drawn from
+    their stationary spread); ``like`` gives the shape and dtype.  Returns
+    the next ``(u, z)``; ``z`` is the offset.
+    """
+    frames = DRIFT_FRAMES if frames is None else frames
+    a = math.exp(-1.0 / frames)
+    # z's variance is (1 - a)^2 gain^2 std^2 (1 + a^2) / (1 - a^2)^2: std^2
+    gain = (1 + a) / math.sqrt(1 + a * a)
+    shape, dtype = like.shape, like.dtype
+    if drift is None:
+        u = rng.standard_normal(shape, dtype=dtype)
+        return u, std * rng.standard_normal(shape, dtype=dtype)
+    u, z = drift
+    u = a * u + math.sqrt(1 - a * a) * rng.standard_normal(shape, dtype=dtype)
+    z = a * z + (1 - a) * gain * std * u
+    return u, z
 
 
 def _fill(

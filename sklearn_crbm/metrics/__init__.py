@@ -6,6 +6,7 @@ every generated sequence and whether it died out, stalled or blew up.
 move like it.
 """
 
+from ._divergence import divergence
 from ._fillin import fillin_angle_rmse, fillin_error
 from ._generation import (
     forward_speed,
@@ -22,6 +23,7 @@ from ._style import StyleJudge
 
 __all__ = [
     "StyleJudge",
+    "divergence",
     "fillin_angle_rmse",
     "fillin_error",
     "foot_skating",

@@ -231,7 +231,9 @@ def generated_liveliness(frames, n_frames, statistics, labels=None):
     return amplitude / reference
 
 
-def lifeless_message(frames, n_frames, statistics, scale=None, labels=None):
+def lifeless_message(
+    frames, n_frames, statistics, scale=None, labels=None, label_names=None
+):
     """What went wrong with generated ``frames`` (long format), or "" if nothing.
 
     A sequence blew up when a value is non-finite, or more than
@@ -241,7 +243,8 @@ def lifeless_message(frames, n_frames, statistics, scale=None, labels=None):
     it died out when its :func:`generated_liveliness` (against the styles
     the label weights ``labels`` ask for, if given) is below
     ``DEAD_FRACTION`` (judged only when ``LIVELINESS_FRAMES`` frames or more
-    were generated).
+    were generated).  ``label_names`` (the model's ``classes_``) names the
+    styles asked for.
     """
     sequences = frames.reshape(-1, n_frames, frames.shape[1])
     with np.errstate(invalid="ignore", over="ignore"):
@@ -258,7 +261,7 @@ def lifeless_message(frames, n_frames, statistics, scale=None, labels=None):
     dead = np.setdiff1d(np.flatnonzero(liveliness < DEAD_FRACTION), blown)
     compared = "the training sequences"
     if labels is not None and "label_amplitude" in statistics:
-        compared += " of the style asked for"
+        compared += " of the style asked for" + _styles_asked(labels, label_names)
     parts = []
     if len(blown):
         parts.append(
@@ -279,6 +282,23 @@ def lifeless_message(frames, n_frames, statistics, scale=None, labels=None):
             "guide's 'Training on your own corpus'."
         )
     return " ".join(parts)
+
+
+def _styles_asked(labels, label_names):
+    """``" ('fast')"``, or ``" ('fast' 0.5, 'slow' 0.5)"`` for a blend: the
+    styles of the label weights of the frames judged, with their weights;
+    "" without names."""
+    if label_names is None:
+        return ""
+    weights = to_numpy(labels)[-LIVELINESS_FRAMES:].mean(axis=0)
+    asked = np.flatnonzero(weights > 0)
+    asked = asked[np.argsort(-weights[asked], kind="stable")]
+    names = [np.asarray(label_names)[k] for k in asked]
+    names = [repr(n.item() if isinstance(n, np.generic) else n) for n in names]
+    if len(asked) == 1:
+        return f" ({names[0]})"
+    weighted = (f"{n} {weights[k]:.2f}" for n, k in zip(names, asked, strict=True))
+    return " (" + ", ".join(weighted) + ")"
 
 
 def _count(indices, n_sequences):

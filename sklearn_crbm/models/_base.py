@@ -6,6 +6,7 @@
 :class:`~sklearn_crbm.FactoredCRBM` and :class:`~sklearn_crbm.LabelledCRBM`.
 """
 
+import inspect
 from abc import ABCMeta, abstractmethod
 from numbers import Integral, Real
 
@@ -92,6 +93,8 @@ class BaseCRBM(
         "batching": [StrOptions({"balanced", "shuffled"})],
         "history_noise": [Interval(Real, 0, None, closed="left")],
         "n_iter": [Interval(Integral, 1, None, closed="left"), StrOptions({"auto"})],
+        "n_mean_field": [Interval(Integral, 1, None, closed="left")],
+        "hidden_drift": [Interval(Real, 0, None, closed="left")],
         "random_state": ["random_state"],
         "verbose": ["verbose"],
     }
@@ -120,6 +123,8 @@ class BaseCRBM(
         history_noise_fraction,
         average_fraction,
         n_iter,
+        n_mean_field,
+        hidden_drift,
         random_state,
         verbose,
     ):
@@ -139,8 +144,21 @@ class BaseCRBM(
         self.history_noise_fraction = history_noise_fraction
         self.average_fraction = average_fraction
         self.n_iter = n_iter
+        self.n_mean_field = n_mean_field
+        self.hidden_drift = hidden_drift
         self.random_state = random_state
         self.verbose = verbose
+
+    def __setstate__(self, state):
+        # Models pickled before sample's settings became parameters sampled
+        # with the class's default mean-field steps and no drift.
+        state = dict(state)
+        parameters = inspect.signature(type(self).__init__).parameters
+        if "n_mean_field" in parameters and "n_mean_field" not in state:
+            state["n_mean_field"] = parameters["n_mean_field"].default
+        if "hidden_drift" in parameters:
+            state.setdefault("hidden_drift", 0.0)
+        super().__setstate__(state)
 
     # ---------------------------------------------------------------- hooks
 

@@ -81,7 +81,22 @@ class ConditionalRBM(BaseLayerModel):
         Epochs without an improvement of ``tol`` that stop training; epochs
         between two validation scores.
     tol : float, default=1e-3
-        Improvement of the validation score (nats per frame) that counts.
+        Improvement of the validation score, in nats per frame, that counts.
+    n_mean_field : int, default=10
+        Mean-field steps (hidden probabilities, then visible means) that end
+        every frame :meth:`sample` generates, after its Gibbs iterations.
+        One (the original code's) leaves the frame where the last sampled
+        hidden states put it, and the frames shake; more settle it at the
+        mean-field fixed point of the mode the chain ended in: smooth, but
+        deterministic given the past, so that without ``hidden_drift``
+        sequences generated from one seed become copies of each other.
+    hidden_drift : float, default=0.3
+        Standard deviation of a random offset of the hidden biases of every
+        sequence :meth:`sample` generates, which changes smoothly over a
+        few frames and holds through all of a frame's steps: randomness that
+        keeps sequences from one seed apart without shaking the frames, in
+        the units of the hidden units' input (as ``hidden_noise``); ``0``:
+        none.
     random_state : int, RandomState instance or None, default=None
         Seeds training and, unless :meth:`sample` is given its own, generation.
     verbose : int, default=0
@@ -193,6 +208,8 @@ class ConditionalRBM(BaseLayerModel):
         n_iter_no_change=50,
         validation_interval=10,
         tol=1e-3,
+        n_mean_field=10,
+        hidden_drift=0.3,
         random_state=None,
         verbose=0,
     ):
@@ -210,6 +227,8 @@ class ConditionalRBM(BaseLayerModel):
             history_noise_fraction=history_noise_fraction,
             average_fraction=average_fraction,
             n_iter=n_iter,
+            n_mean_field=n_mean_field,
+            hidden_drift=hidden_drift,
             random_state=random_state,
             verbose=verbose,
         )

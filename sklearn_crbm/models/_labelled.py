@@ -53,6 +53,23 @@ class LabelledCRBM(BaseStyleModel):
     n_iter_no_change : int, default=50
     validation_interval : int, default=10
     tol : float, default=1e-3
+    n_mean_field : int, default=1
+        Mean-field steps (hidden probabilities, then visible means) that end
+        every frame :meth:`sample` generates, after its Gibbs iterations.
+        One (the original code's) leaves the frame where the last sampled
+        hidden states put it, and the frames shake; more settle it at the
+        mean-field fixed point of the mode the chain ended in: smooth, but
+        deterministic given the past, so that without ``hidden_drift``
+        sequences generated from one seed become copies of each other.
+        The style models take one: ten settle a blend of two styles into
+        one gait.
+    hidden_drift : float, default=0.0
+        Standard deviation of a random offset of the hidden biases of every
+        sequence :meth:`sample` generates, which changes smoothly over a
+        few frames and holds through all of a frame's steps: randomness that
+        keeps sequences from one seed apart without shaking the frames, in
+        the units of the hidden units' input (as ``hidden_noise``); ``0``:
+        none.
     random_state : int, RandomState instance or None, default=None
     verbose : int, default=0
         The parameters without a description are those of
@@ -159,6 +176,8 @@ class LabelledCRBM(BaseStyleModel):
         n_iter_no_change=50,
         validation_interval=10,
         tol=1e-3,
+        n_mean_field=1,
+        hidden_drift=0.0,
         random_state=None,
         verbose=0,
     ):
@@ -176,6 +195,8 @@ class LabelledCRBM(BaseStyleModel):
             history_noise_fraction=history_noise_fraction,
             average_fraction=average_fraction,
             n_iter=n_iter,
+            n_mean_field=n_mean_field,
+            hidden_drift=hidden_drift,
             random_state=random_state,
             verbose=verbose,
         )

@@ -35,6 +35,10 @@ __all__ = ["SamplingMixin", "seed_frames"]
 MAX_SEED_WINDOWS = 500
 # Gibbs iterations per generated frame of a model without an ``n_gibbs``.
 DEFAULT_N_GIBBS = 30
+# What sample does for a model without the parameters n_mean_field and
+# hidden_drift (a layer model defined outside the package).
+DEFAULT_N_MEAN_FIELD = 10
+DEFAULT_HIDDEN_DRIFT = 0.0
 # Standard deviation of the jitter added to the previous frame to start the
 # Gibbs chain of a new frame (the original code's gen.m).
 START_JITTER = 0.01
@@ -45,15 +49,11 @@ class SamplingMixin:
 
     Hooks, which a model overrides where it differs: ``_liveliness_labels``
     (the label weights generated motion is judged by), ``_chain_rng`` (in
-    :class:`~sklearn_crbm.models._base.BaseCRBM`), ``_start_jitter`` and
-    ``_n_mean_field``.
+    :class:`~sklearn_crbm.models._base.BaseCRBM`) and ``_start_jitter``.
     """
 
     # Noise on the previous frame where a new frame's Gibbs chain starts.
     _start_jitter = START_JITTER
-
-    # Mean-field steps that end a generated frame unless sample is told.
-    _n_mean_field = 10
 
     @limit_blas_threads(sequence_rows)
     def sample(
@@ -68,6 +68,7 @@ class SamplingMixin:
         hidden_noise=0.0,
         sample_visibles=False,
         n_mean_field=None,
+        hidden_drift=None,
         random_state=None,
         n_jobs=None,
     ):
@@ -76,11 +77,14 @@ class SamplingMixin:
         Each new frame starts from the previous frame plus N(0, 0.01^2)
         jitter; ``n_gibbs`` alternating Gibbs iterations follow (hidden units
         sampled, visibles set to their mean), then ``n_mean_field``
-        mean-field steps (hidden probabilities, visible means).  All
-        sequences are generated together.  A stack does this in its top
-        layer, whose visible units are the hidden probabilities of the layer
-        below, and each layer below turns them into its visible means given
-        its own generated past, down to the data (Taylor's ``gen2.m``).
+        mean-field steps (hidden probabilities, visible means).  With
+        ``hidden_drift``, every sequence's hidden biases carry a random
+        offset that changes smoothly from frame to frame and holds through
+        all of a frame's steps.  All sequences are generated together.  A
+        stack does this in its top layer, whose visible units are the hidden
+        probabilities of the layer below, and each layer below turns them
+        into its visible means given its own generated past, down to the
+        data (Taylor's ``gen2.m``).
 
         Parameters
         ----------
@@ -123,12 +127,12 @@ default=None
             motion.
         n_mean_field : int, default=None
             Mean-field steps that end each frame (ignored with
-            ``sample_visibles``).  The original code takes one, which leaves
-            the frame where the last sampled hidden states put it, and the
-            frames shake; further steps settle it at the mean-field fixed
-            point of the mode the chain ended in.  None: 10, or 1 for the
-            style models, where ten settle a blend of two styles into one
-            gait.
+            ``sample_visibles``); None: the model's ``n_mean_field``
+            parameter.
+        hidden_drift : float, default=None
+            Standard deviation of the smooth random offset of the (top
+            layer's) hidden biases that keeps sequences apart; None: the
+            model's ``hidden_drift`` parameter.
         random_state : int, RandomState instance or None, default=None
             Seeds the generation; ``None`` uses the estimator's
             ``random_state``, so repeated calls give the same frames when
@@ -150,13 +154,20 @@ default=None
         """
         check_is_fitted(self)
         n_samples = check_count(n_samples, "n_samples", minimum=1)
+        params = self.get_params()
         if n_gibbs is None:
-            n_gibbs = self.get_params().get("n_gibbs", DEFAULT_N_GIBBS)
+            n_gibbs = params.get("n_gibbs", DEFAULT_N_GIBBS)
         n_gibbs = check_count(n_gibbs, "n_gibbs", minimum=0)
         n_sequences = check_count(n_sequences, "n_sequences", minimum=1)
         if n_mean_field is None:
-            n_mean_field = self._n_mean_field
+            n_mean_field = params.get("n_mean_field", DEFAULT_N_MEAN_FIELD)
         n_mean_field = check_count(n_mean_field, "n_mean_field", minimum=1)
+        if hidden_drift is None:
+            hidden_drift = params.get("hidden_drift", DEFAULT_HIDDEN_DRIFT)
+        if not isinstance(hidden_drift, Real) or not hidden_drift >= 0:
+            raise ValueError(
+                f"hidden_drift must be a non-negative number, got {hidden_drift!r}."
+            )
         if not isinstance(hidden_noise, Real) or not hidden_noise >= 0:
             raise ValueError(
                 f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
@@ -189,6 +200,7 @@ default=None
             hidden_noise=hidden_noise,
             sample_visibles=sample_visibles,
             n_mean_field=n_mean_field,
+            hidden_drift=hidden_drift,
             n_jobs=n_jobs,
         )
         self._check_generated(frames, n_samples, labels)
@@ -209,7 +221,12 @@ default=None
         # binary visibles stay within [0, 1]: only non-finite values blew up
         scale = np.inf if self._layers()[0].binary else statistics.scale
         message = lifeless_message(
-            to_numpy(frames), n_frames, statistics, scale, labels
+            to_numpy(frames),
+            n_frames,
+            statistics,
+            scale,
+            labels,
+            getattr(self, "classes_", None),
         )
         if message:
             warnings.warn(message, GenerationWarning, stacklevel=_caller_level())
@@ -220,7 +237,8 @@ default=None
         ``seed`` has shape ``(n_sequences, width, n_features)``; ``context``
         (shape ``(n_sequences, n_samples, n_context)``) gives each new frame's
         context to a layer that takes one.  ``gibbs`` holds ``n_gibbs``,
-        ``hidden_noise``, ``sample_visibles`` and ``n_mean_field``.
+        ``hidden_noise``, ``sample_visibles``, ``n_mean_field`` and
+        ``hidden_drift``.
         """
         layers = self._layers()
         ops = layers[0].ops

@@ -76,6 +76,21 @@ class StackedCRBM(BaseCRBM):
         the last epoch's.
     n_iter : int, default=200
         Epochs per layer.
+    n_mean_field : int, default=10
+        Mean-field steps (hidden probabilities, then visible means) that end
+        every frame :meth:`sample` generates, after its Gibbs iterations.
+        One (the original code's) leaves the frame where the last sampled
+        hidden states put it, and the frames shake; more settle it at the
+        mean-field fixed point of the mode the chain ended in: smooth, but
+        deterministic given the past, so that without ``hidden_drift``
+        sequences generated from one seed become copies of each other.
+    hidden_drift : float, default=0.0
+        Standard deviation of a random offset of the hidden biases of every
+        sequence :meth:`sample` generates, which changes smoothly over a
+        few frames and holds through all of a frame's steps: randomness that
+        keeps sequences from one seed apart without shaking the frames, in
+        the units of the hidden units' input (as ``hidden_noise``); ``0``:
+        none.
     random_state : int, RandomState instance or None, default=None
         Seeds every layer (each gets its own integer seed drawn from it) and,
         unless ``sample`` is given its own, generation.
@@ -178,6 +193,8 @@ class StackedCRBM(BaseCRBM):
         },
         "n_components": [Interval(Integral, 1, None, closed="left"), "array-like"],
         "history_noise": [Interval(Real, 0, None, closed="left"), "array-like"],
+        "n_mean_field": ConditionalRBM._parameter_constraints["n_mean_field"],
+        "hidden_drift": ConditionalRBM._parameter_constraints["hidden_drift"],
         "random_state": ["random_state"],
         "estimator": [HasMethods(["fit", "transform", "conditional_layers"]), None],
     }
@@ -199,6 +216,8 @@ class StackedCRBM(BaseCRBM):
         history_noise_fraction=1.0,
         average_fraction=0.0,
         n_iter=200,
+        n_mean_field=10,
+        hidden_drift=0.0,
         random_state=None,
         verbose=0,
         estimator=None,
@@ -217,6 +236,8 @@ class StackedCRBM(BaseCRBM):
             history_noise_fraction=history_noise_fraction,
             average_fraction=average_fraction,
             n_iter=n_iter,
+            n_mean_field=n_mean_field,
+            hidden_drift=hidden_drift,
             random_state=random_state,
             verbose=verbose,
         )

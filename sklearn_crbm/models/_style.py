@@ -92,10 +92,6 @@ class BaseStyleModel(BaseLayerModel):
     takes a real-valued context instead (no ``classes_``).
     """
 
-    # Ten mean-field steps settle a blend of two styles into one gait (the
-    # styles guide has the measurement), so style models end a frame with one.
-    _n_mean_field = 1
-
     _parameter_constraints: dict = {
         **BaseLayerModel._parameter_constraints,
         "priors": ["array-like", None],
