@@ -13,7 +13,6 @@ types them one after the other would.
 import doctest
 import os
 import re
-import shlex
 import subprocess
 import sys
 import textwrap

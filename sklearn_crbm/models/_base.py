@@ -166,10 +166,6 @@ class BaseCRBM(
     def _fitted_layers(self):
         """The fitted :class:`~sklearn_crbm.layers.ConditionalLayer` s, bottom first."""
 
-    def _layers(self):
-        # the old name, for models/_sampling.py's calls until they are renamed
-        return self._fitted_layers()
-
     @abstractmethod
     def _planned_layers(self, n_features):
         """The layers ``fit`` would make for ``n_features`` (not initialised)."""

@@ -183,7 +183,7 @@ default=None
             n_sequences,
             width=max(self.history_length, 1),
             n_features=self.n_features_in_,
-            dtype=self._layers()[0].dtype,
+            dtype=self._fitted_layers()[0].dtype,
             seed_windows=self.seed_windows_,
             rng=rng,
         )
@@ -219,7 +219,7 @@ default=None
         if statistics is None:
             return
         # binary visibles stay within [0, 1]: only non-finite values blew up
-        scale = np.inf if self._layers()[0].binary else statistics.scale
+        scale = np.inf if self._fitted_layers()[0].binary else statistics.scale
         message = lifeless_message(
             to_numpy(frames),
             n_frames,
@@ -240,7 +240,7 @@ default=None
         ``hidden_noise``, ``sample_visibles``, ``n_mean_field`` and
         ``hidden_drift``.
         """
-        layers = self._layers()
+        layers = self._fitted_layers()
         ops = layers[0].ops
         seed_context = None if context is None else context[None, :, 0, ...]
         past = History.from_frames(layers, seed[None, ...], seed_context)
@@ -301,7 +301,7 @@ default=None
         ops = array_ops(X)
         windows = ops.take(X, rows.ravel(), axis=0)
         windows = ops.reshape(windows, (*rows.shape, X.shape[1]))
-        return ops.astype(windows, self._layers()[0].dtype, copy=True)
+        return ops.astype(windows, self._fitted_layers()[0].dtype, copy=True)
 
     def _merge_seed_windows(self, new):
         """Seed windows of a ``partial_fit`` call joined to the earlier ones."""
