@@ -9,6 +9,11 @@ seed's style, stays within |z| <= 10, and its leg amplitude is within 25%
 and step frequency within 15% of its style's real trials.  Criterion:
 windows passing (240 for seeds 0-4 and both encodings).
 
+Variety and smoothness from one seed: 4 sequences of 400 frames from the
+first walk window, and 4 from the first jog window, judged on frames
+200-399 by ``metrics.divergence`` (0: copies, 1: unrelated motion) and
+``metrics.jitter`` of their joint positions over the real trials'.
+
 Run from the repository root (fitted models are cached)::
 
     python benchmarks/generation_seeds.py
@@ -18,6 +23,7 @@ Run from the repository root (fitted models are cached)::
 import json
 
 import numpy as np
+import sklearn
 from _common import (
     PAPER_ENCODING,
     MotionCorpus,
@@ -29,6 +35,7 @@ from _common import (
 )
 
 from sklearn_crbm import ConditionalRBM
+from sklearn_crbm.metrics import divergence, jitter
 
 ENCODINGS = {"paper": PAPER_ENCODING, "default": {}}
 STYLES = ("walk", "jog")
@@ -36,6 +43,7 @@ N_PER_STYLE = 6
 WINDOWS = {"200-299": 300, "900-999": 1000}  # frames judged -> their end
 AMPLITUDE_TOLERANCE, FREQUENCY_TOLERANCE = 0.25, 0.15
 VERDICTS = ("style", "amplitude", "frequency", "blown")  # kept per sequence
+N_FROM_ONE, ONE_SEED_FRAMES, ONE_SEED_JUDGED = 4, 400, slice(200, 400)
 
 
 def passes(corpus, generated, n_frames, end, seed_styles):
@@ -53,6 +61,38 @@ def passes(corpus, generated, n_frames, end, seed_styles):
     return (verdict.style == seed_styles) & ~verdict.blown & lively & in_step, verdict
 
 
+def _positions(corpus, Z, ids):
+    with sklearn.config_context(enable_metadata_routing=True):
+        raw = corpus.preprocessor.inverse_transform(Z, sequence_ids=ids)
+    return corpus.data.skeleton.forward_kinematics(raw)
+
+
+def real_jitter(corpus, style):
+    """Mean jitter of the joint positions of the real trials of ``style``."""
+    rows = np.isin(corpus.ids, np.flatnonzero(corpus.styles == style))
+    positions = _positions(corpus, corpus.Z[rows], corpus.ids[rows])
+    return float(np.mean(jitter(positions, sequence_ids=corpus.ids[rows])))
+
+
+def from_one_seed(corpus, model, history, seed_styles, seed):
+    """Divergence and relative jitter of sequences that share one seed window."""
+    row = {}
+    ids = np.repeat(np.arange(N_FROM_ONE), ONE_SEED_FRAMES)
+    judged = np.tile(np.arange(ONE_SEED_FRAMES), N_FROM_ONE) >= ONE_SEED_JUDGED.start
+    for style in STYLES:
+        first = int(np.flatnonzero(seed_styles == style)[0])
+        shared = np.repeat(history[first : first + 1], N_FROM_ONE, axis=0)
+        Z = model.sample(ONE_SEED_FRAMES, history=shared, random_state=seed)
+        row[f"{style} divergence"] = divergence(
+            Z, sequence_ids=ids, frames=ONE_SEED_JUDGED
+        )
+        positions = _positions(corpus, Z, ids)[judged]
+        row[f"{style} jitter"] = float(
+            np.mean(jitter(positions, sequence_ids=ids[judged]))
+        ) / real_jitter(corpus, style)
+    return row
+
+
 def generate_and_judge(corpus, seed, model_params):
     model = ConditionalRBM(random_state=seed, **model_params)
     model, _ = cached_fit(model, corpus.Z.astype(np.float32), corpus.ids)
@@ -67,6 +107,7 @@ def generate_and_judge(corpus, seed, model_params):
             row[f"{style} {window}"] = int(passed[mine].sum())
             judged = {key: verdict[key][mine].tolist() for key in VERDICTS}
             details[f"{style} {window}"] = dict(passes=passed[mine].tolist(), **judged)
+    row.update(from_one_seed(corpus, model, history, seed_styles, seed))
     return row, details
 
 
@@ -88,9 +129,15 @@ def main(argv=None):
             print(f"  {encoding} seed {seed}: {row}", flush=True)
     cells = [f"{s} {w}" for w in WINDOWS for s in STYLES]
     total = sum(row[cell] for row in rows for cell in cells)
-    columns = ["encoding", "seed"] + [
-        (cell, f"{cell.replace(' ', 's pass, frames ')}", "d") for cell in cells
-    ]
+    columns = (
+        ["encoding", "seed"]
+        + [(cell, f"{cell.replace(' ', 's pass, frames ')}", "d") for cell in cells]
+        + [
+            (f"{style} {key}", f"{style}: {key} from one seed", ".2f")
+            for style in STYLES
+            for key in ("divergence", "jitter")
+        ]
+    )
     table = print_table(
         rows,
         columns,

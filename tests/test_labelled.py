@@ -84,10 +84,12 @@ def test_imputer_fills_in_with_the_style_given_or_inferred(fitted):
     assert errors[None] < 0.1 * errors["low"]
 
 
-def test_style_models_end_a_frame_with_one_mean_field_step(fitted):
-    """Ten steps settle a blend of styles into one gait; a style model takes one."""
+def test_frames_end_with_ten_mean_field_steps_and_a_drift(fitted):
+    """As ConditionalRBM: ten mean-field steps, a hidden drift of 0.3."""
     seed = styled_data(random_state=1, switching=False)[0][:5]
     given = dict(history=seed, style="high", random_state=0)
     default = fitted.sample(30, **given)
-    assert_array_equal(default, fitted.sample(30, n_mean_field=1, **given))
-    assert not np.allclose(default, fitted.sample(30, n_mean_field=10, **given))
+    settings = dict(n_mean_field=10, hidden_drift=0.3)
+    assert_array_equal(default, fitted.sample(30, **settings, **given))
+    assert not np.allclose(default, fitted.sample(30, n_mean_field=1, **given))
+    assert not np.allclose(default, fitted.sample(30, hidden_drift=0.0, **given))

@@ -53,7 +53,7 @@ class LabelledCRBM(BaseStyleModel):
     n_iter_no_change : int, default=50
     validation_interval : int, default=10
     tol : float, default=1e-3
-    n_mean_field : int, default=1
+    n_mean_field : int, default=10
         Mean-field steps (hidden probabilities, then visible means) that end
         every frame :meth:`sample` generates, after its Gibbs iterations.
         One (the original code's) leaves the frame where the last sampled
@@ -61,9 +61,7 @@ class LabelledCRBM(BaseStyleModel):
         mean-field fixed point of the mode the chain ended in: smooth, but
         deterministic given the past, so that without ``hidden_drift``
         sequences generated from one seed become copies of each other.
-        The style models take one: ten settle a blend of two styles into
-        one gait.
-    hidden_drift : float, default=0.0
+    hidden_drift : float, default=0.3
         Standard deviation of a random offset of the hidden biases of every
         sequence :meth:`sample` generates, which changes smoothly over a
         few frames and holds through all of a frame's steps: randomness that
@@ -176,8 +174,8 @@ class LabelledCRBM(BaseStyleModel):
         n_iter_no_change=50,
         validation_interval=10,
         tol=1e-3,
-        n_mean_field=1,
-        hidden_drift=0.0,
+        n_mean_field=10,
+        hidden_drift=0.3,
         random_state=None,
         verbose=0,
     ):
