@@ -1,20 +1,14 @@
 """Generation and fill-in speed of the paper's model: ``sample`` and ``CRBMImputer``.
 
-The paper's model size (62 dimensions, 200 hidden units, order 3), trained
-briefly on CMU subject 35 (speed does not depend on how well it is
-trained), float64 and float32, one BLAS thread; "x real time" is against
-30 frames per second.  ``--parts``:
-
-- ``generate``: ``--n-frames`` new frames, 30 Gibbs steps per frame (the
-  original code's scheme), for 1 and ``--n-sequences`` sequences together,
-  against the same scheme as a straightforward numpy loop ("x naive");
-- ``fillin``: ``CRBMImputer`` at its defaults (20 particles per draw) fills
-  the left leg or the upper body of the paper split's two test trials,
-  erased in every frame, on-line, for ``--n-draws`` averaged draws.
+The paper's model size (62 dimensions, 200 hidden units, order 3) briefly
+trained on CMU 35, float64 and float32, one BLAS thread; "x real time" is
+against 30 frames per second.  ``generate``: ``--n-frames`` frames, 30 Gibbs
+steps each, for 1 and ``--n-sequences`` sequences, against a plain numpy
+loop ("x naive").  ``fillin``: ``CRBMImputer`` at its defaults fills the
+left leg or upper body of the two test trials on-line, ``--n-draws`` draws.
 
 Run from the repository root (about two minutes)::
 
-    python benchmarks/bench_generate.py
     python benchmarks/bench_generate.py --parts fillin --n-draws 1 10
 """
 

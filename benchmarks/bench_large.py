@@ -3,12 +3,11 @@
 Issue 18's configuration: 10^6 synthetic frames x 100 channels
 (``_common.synthetic_motion``) or every BVH/AMC file of ``--corpus``
 (preprocessed as the demo does); 1000 hidden units, order 3, float64 and
-float32; best of ``--repeats``.  Rows: ``train`` (one epoch of
-``partial_fit`` on ``--train-frames`` frames, batch 100 and 1000, 1 and all
-BLAS threads), ``products`` (its six matrix products alone; ``/ products``
-is bounded at 1.3), ``sample`` (``--gen-frames`` frames of 1000 sequences
-together), and the same on a CUDA GPU through the array API when PyTorch
-sees one.  Peak memory: ``tracemalloc`` (GPU: ``max_memory_allocated``).
+float32; best of ``--repeats``.  Rows: ``train`` (an epoch of
+``partial_fit``, batch 100 and 1000, 1 and all threads), ``products`` (its
+matrix products alone, ``/ products`` at most 1.3), ``sample`` (1000
+sequences together), and the same on a CUDA GPU when PyTorch sees one.
+Peak memory: ``tracemalloc`` (GPU: ``max_memory_allocated``).
 
 Run from the repository root::
 

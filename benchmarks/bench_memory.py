@@ -1,14 +1,11 @@
 """Memory that ConditionalRBM.fit adds on top of its data, whatever the order.
 
-Per order (``--orders``), a fresh process builds ``--frames`` (10^6)
-synthetic float32 frames of 62 dimensions (sequences of 100 frames), fits a
-200-hidden-unit CRBM for one epoch and reports the peak allocated during
-``fit`` above what was before (``tracemalloc``) and the growth of peak RSS
-(``VmHWM``, Linux).  Budget: what ``fit`` adds stays under 150 MB.
+Per order (``--orders``), in a fresh process: one epoch of a 200-unit CRBM
+on ``--frames`` (10^6) synthetic float32 frames of 62 dimensions; the peak
+that ``fit`` adds (``tracemalloc``; RSS ``VmHWM``), at most 150 MB.
 
-Run from the repository root::
+Run from the repository root (about a minute)::
 
-    python benchmarks/bench_memory.py                     # about a minute
     python benchmarks/bench_memory.py --orders 1 3 6 12 24
 """
 

@@ -2,10 +2,9 @@
 
 Around the paper's configuration (62 dimensions, 200 hidden units, order 3,
 batch 100, CD-1, one BLAS thread) on synthetic motion: frames 10^3-10^6
-(``--frames``; the cost per frame should stay flat), order 1-12
-(``--orders``) and hidden units 50-800 (``--components``) on 2644 frames.
-Per row: ms per epoch (best of ``--repeats``), us per frame, GFLOP/s and the
-fraction of a 2000 x 2000 product's rate.
+(``--frames``), order 1-12 (``--orders``) and hidden units 50-800
+(``--components``): ms per epoch (best of ``--repeats``), us per frame,
+GFLOP/s and the fraction of a 2000 x 2000 product's rate.
 
 Run from the repository root (about two minutes)::
 

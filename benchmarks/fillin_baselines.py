@@ -1,14 +1,13 @@
 """Filling in: the defaults against every simple baseline, by mean log ratio.
 
-The paper's §4.4 on two splits of CMU subject 35 (``paper``: 35_29 and
-35_18 held out; ``second``: 35_05 and 35_22), the paper's encoding: the left
-leg or the upper body of each held-out trial erased from half-way and
-filled on-line; the paper's error.  Baselines: ``NearestNeighborImputer``,
-``KNNImputer`` (1, 5, 10) and ``AutoregressiveImputer`` (full, diagonal);
-the CRBM: ``CRBMImputer`` around ``ConditionalRBM(random_state=seed)``
-(``--model``, ``--imputer``: JSON parameters).  Per kind of cell and
-pooled: the mean over seeds of ``log(CRBM error / best baseline error)``,
-its 95% bootstrap interval, and the seed-cells won.
+The paper's §4.4 on two splits of CMU 35 (``paper``: 35_29, 35_18 held
+out; ``second``: 35_05, 35_22), the paper's encoding and error: left leg or
+upper body erased from half-way, filled on-line by ``CRBMImputer`` around
+``ConditionalRBM(random_state=seed)`` (``--model``, ``--imputer``) and by
+``NearestNeighborImputer``, ``KNNImputer`` (1, 5, 10) and
+``AutoregressiveImputer`` (full, diagonal).  Per kind of cell and pooled:
+the mean over seeds of ``log(CRBM error / best baseline error)`` with its
+95% bootstrap interval, and the seed-cells won.
 
 Run from the repository root (fitted models are cached)::
 

@@ -4,15 +4,11 @@ Per training seed and encoding (``--encodings``: the paper's and the
 default): ``ConditionalRBM(random_state=seed)`` (``--model``) on all 33
 trials of CMU 35; 6 walk- and 6 jog-seeded sequences of 1000 frames
 (``MotionPipeline.style_windows``); frames 200-299 and 900-999 judged
-(``metrics.judge_generated_motion``): a window passes when it keeps its
-seed's style, stays within |z| <= 10, and its leg amplitude is within 25%
-and step frequency within 15% of its style's real trials.  Criterion:
-windows passing (240 for seeds 0-4 and both encodings).
-
-Variety and smoothness from one seed: 4 sequences of 400 frames from the
-first walk window, and 4 from the first jog window, judged on frames
-200-399 by ``metrics.divergence`` (0: copies, 1: unrelated motion) and
-``metrics.jitter`` of their joint positions over the real trials'.
+(``metrics.judge_generated_motion``: style kept, |z| <= 10, leg amplitude
+and step frequency within 25% and 15% of the style's): windows passing,
+240 for seeds 0-4 and both encodings.  From one seed, 4 sequences of 400
+frames from the first walk and jog windows, frames 200-399:
+``metrics.divergence`` (0: copies) and ``metrics.jitter`` over the real's.
 
 Run from the repository root (fitted models are cached)::
 

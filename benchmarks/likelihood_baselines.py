@@ -2,12 +2,10 @@
 
 On the splits of ``fillin_baselines.py``: the mean held-out ``log p(x_t |
 past)`` (nats per frame) of the ridge AR(3) with unit, per-channel and full
-residual variance (closed form); ``ConditionalRBM()``; and the density model
-(``init="autoregressive"``, ``visible_variance="residual"``,
-``centering=True``, clean histories, 60 epochs), also with ``W`` and the
-past-to-hidden weights set to 0.  CRBM scores are
-``estimate_log_likelihood``'s forward and reverse annealed estimates
-(``--ais STEPS CHAINS``; default 50 x 2).
+residual variance (closed form); ``ConditionalRBM()``; the density model
+(``init="autoregressive"``, ``visible_variance="residual"``, centred, clean
+histories, 60 epochs), also without ``W`` and past-to-hidden weights; the
+CRBMs by forward and reverse annealing (``--ais STEPS CHAINS``, 50 x 2).
 
 Run from the repository root (models shared with ``fillin_baselines.py``)::
 

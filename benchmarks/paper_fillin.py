@@ -3,12 +3,11 @@
 Train on the 31 training trials (the paper's encoding); erase the left leg
 or the upper body of 35_29 and 35_18 from half-way; fill in on-line; the
 paper's error and degrees, the CRBM by the mean of ``--n-repeats`` single
-draws.  The paper, for the walk: leg 8.78 (nearest neighbour 11.68), upper
-body 20.52 (22.20).  ``--variants``: ``paper``
-(``ConditionalRBM.paper_schedule()``, single-chain ``CRBMImputer``) and
-``defaults``.  Baselines: ``NearestNeighborImputer``, ``KNNImputer(5)``,
-``IterativeImputer``.  Per variant and cell: the mean log ratio to nearest
-neighbour over seeds, its 95% bootstrap interval, the seeds that beat it.
+draws (the paper's walk: leg 8.78, nearest neighbour 11.68; upper body
+20.52, 22.20).  ``--variants``: ``paper`` (``paper_schedule()``, one chain)
+and ``defaults``; beside ``KNNImputer(5)`` and ``IterativeImputer``.  Per
+variant and cell: the mean log ratio to nearest neighbour over seeds with
+its 95% interval, and the seeds that beat it.
 
 Run from the repository root (fitted models are cached)::
 

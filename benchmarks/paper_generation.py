@@ -7,9 +7,8 @@ most one dies out.  ``--models``: ``paper``
 (``paper_schedule(n_iter=1000)``), ``defaults``, ``stacked``
 (``StackedCRBM((200, 200), order=3, n_iter=500)``) and ``stacked-noisy``
 (``history_noise=0.4``); ``--datasets``: ``cmu`` (CMU 35) and ``mit``.
-``transitions``: the CMU ``defaults`` model, 12 sequences of 1200 frames
-with ``hidden_noise``; windows of 60 frames labelled walk, jog, still or
-blown, and switches counted per direction.
+``transitions``: 12 sequences of 1200 frames of the CMU ``defaults`` with
+``hidden_noise``; switches between 60-frame windows counted per direction.
 
 Run from the repository root::
 

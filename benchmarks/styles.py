@@ -5,24 +5,17 @@ second), the default ``make_motion_preprocessor`` fitted on takes 001-005;
 the takes 006 are held out.  ``FactoredCRBM`` with the defaults per seed of
 ``--seeds`` (``--n-iter`` shortens training).  Parts (``--parts``):
 
-- ``style``: per style, ``--n-sequences`` x ``--n-frames`` frames seeded
-  with a normal walk: 2-s windows from frame 100 judged the style (kept)
-  and alive (``StyleJudge`` on all 42 takes); leg amplitude and step
-  frequency over the last 100 frames within 25% and 15% of the style's;
-  blow-ups (beyond twice a channel's largest real |z|).
-- ``blends``: the 21 pairs at 50/50: windows judged one of the two; forward
-  speed and step frequency between the two styles' (10% margin).
-- ``transitions``: the 42 ordered pairs switched at half the sequence:
-  windows from 60 frames after the switch judged the new style and alive.
-- ``likelihood``: held-out log-likelihood per frame of the takes 006 (from
-  their 13th frame), its standard error and the reverse estimate's gap.
-- ``recognition``: ``predict`` on the first 300 frames of every take 006.
-- ``fillin``: left leg or upper body of every take 006 erased from
-  half-way: mean log ratio of the error to the best of ``KNNImputer(5)``,
-  ``KNNImputer(10)`` and ``AutoregressiveImputer()``, 95% bootstrap interval.
-- ``speed``: seconds per epoch; the matrix products alone of 100
-  sequences generated together as a fraction of their generation's time
-  (at least 0.6).
+``style``: per style, ``--n-sequences`` x ``--n-frames`` frames from a
+normal walk; 2-s windows from frame 100 judged the style and alive
+(``StyleJudge``), gait within 25%/15% of the style's, no blow-up.
+``blends``: the 21 pairs at 50/50, judged one of the two, speed and step
+frequency between the two.  ``transitions``: the 42 ordered pairs switched
+half-way, judged the new style 60 frames on.  ``likelihood``: held-out
+log-likelihood per frame of the takes 006.  ``recognition``: ``predict`` on
+every take 006.  ``fillin``: left leg or upper body of every take 006 from
+half-way, mean log ratio to the best of ``KNNImputer`` (5, 10) and
+``AutoregressiveImputer``.  ``speed``: seconds per epoch; the products'
+share of generating 100 sequences together (at least 0.6).
 
 Run from the repository root; results are cached per seed, keyed by the
 code, and ``--tabulate`` merges earlier runs' JSON (seeds run apart)::
