@@ -104,6 +104,22 @@ def test_quick_start_is_what_ci_runs():
     assert 'exec bash -c "$test"' in ci and 'bash -c "$venv"' in ci
 
 
+def test_fill_in_claim_says_what_the_results_table_shows():
+    """The introduction's claim about filling in matches the results below."""
+    text = README.read_text(encoding="utf-8")
+    intro = " ".join(text.split("## Quick start", 1)[0].split())
+    claim = re.search(r"fills in [^.]*?\(", intro).group(0)
+    results = text.split("## Results\n", 1)[1].split("\n## ", 1)[0]
+    rows = re.findall(r"^\| (.+?) \| .+? \| (.+?) \| .+? \|$", results, re.M)
+    verdicts = dict(rows[1:])  # below the heading row
+    assert verdicts.pop("all cells") == "better"
+    assert "on average" in claim  # what the all-cells row shows
+    if any(verdict != "better" for verdict in verdicts.values()):
+        assert "not in every case" in claim
+    else:
+        assert "not in every case" not in claim
+
+
 def _run(code, env):
     result = subprocess.run(
         [sys.executable, "-c", fewer_epochs(code)],
