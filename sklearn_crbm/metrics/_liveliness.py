@@ -33,7 +33,7 @@ __all__ = [
 
 # ``sample`` judges the last frames of every generated sequence (more than a
 # cycle of walking or waving at 30 frames per second) against the same
-# number of last frames of every training sequence: moving less than
+# number of frames in the middle of every training sequence: moving less than
 # DEAD_FRACTION as much, it died out; beyond BLOWN_DEVIATIONS standard
 # deviations of the widest channel from the training mean and BLOWN_REACH
 # times as far as the channel's training frames went, it blew up (the toes
@@ -51,9 +51,10 @@ def generation_statistics(X, sequences, labels=None):
 
     A :class:`~sklearn.utils.Bunch`: ``mean`` (every channel's mean),
     ``scale`` (the largest channel standard deviation), ``amplitude`` (the
-    :func:`~sklearn_crbm.metrics.motion_amplitude` of the last
+    :func:`~sklearn_crbm.metrics.motion_amplitude` of the middle
     ``LIVELINESS_FRAMES`` frames of every sequence, their mean weighted by
-    those frames), ``reach`` (every channel's largest distance from its
+    those frames: the cycle of a take, not the rest before or after it),
+    ``reach`` (every channel's largest distance from its
     mean) and ``n_frames``.  Given the frames' label weights
     ``labels`` (shape ``(n_frames, n_classes)``), also ``label_amplitude``:
     that mean for each style alone, each sequence weighted by its frames'
@@ -61,7 +62,10 @@ def generation_statistics(X, sequences, labels=None):
     """
     X = to_numpy(X)
     weights = np.minimum(sequences.lengths, LIVELINESS_FRAMES)
-    amplitudes = _last_frames_amplitude(X, sequences.stops, weights)
+    # the middle frames: a take of waving raises the arms first and lowers
+    # them last, and only its middle is what generation goes on with
+    ends = sequences.starts + (sequences.lengths + weights) // 2
+    amplitudes = _last_frames_amplitude(X, ends, weights)
     mean, scale, reach = _channel_moments(X)
     statistics = Bunch(
         mean=mean,
@@ -72,11 +76,11 @@ def generation_statistics(X, sequences, labels=None):
     )
     if labels is not None:
         labels = to_numpy(labels)
-        # each sequence's label weights summed over its last frames
+        # each sequence's label weights summed over those frames
         sums = np.array(
             [
                 np.asarray(labels[stop - n : stop], dtype=np.float64).sum(axis=0)
-                for stop, n in zip(sequences.stops, weights, strict=True)
+                for stop, n in zip(ends, weights, strict=True)
             ]
         )
         label_weight = sums.sum(axis=0)
