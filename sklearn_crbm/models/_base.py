@@ -435,9 +435,17 @@ n_classes), default=None
         return array_ops(X).astype(log_likelihood, X.dtype)
 
     def _log_likelihood(
-        self, X, sequences, method="auto", reverse=False, rng=None, context=None
+        self,
+        X,
+        sequences,
+        method="auto",
+        reverse=False,
+        rng=None,
+        context=None,
+        frames=None,
     ):
-        """:class:`~sklearn_crbm._engines._likelihood.LogLikelihood` of every frame."""
+        """:class:`~sklearn_crbm._engines._likelihood.LogLikelihood` of every frame
+        (of ``frames`` only, in their order, for a model of one layer)."""
         layers = self._fitted_layers()
         n_steps, n_chains = self._ais_settings()
         rng = rng_from(self.random_state) if rng is None else rng
@@ -445,13 +453,17 @@ n_classes), default=None
         if len(layers) == 1:
             return frame_log_likelihood(
                 X,
-                sequence_frame_rbms(layers[0], X, sequences, context=context),
+                sequence_frame_rbms(
+                    layers[0], X, sequences, frames=frames, context=context
+                ),
                 method=method,
                 n_steps=n_steps,
                 n_chains=n_chains,
                 reverse=reverse,
                 rng=rng,
             )
+        if frames is not None:
+            raise NotImplementedError("frames= with a stack of layers")
         ops = array_ops(X)
         bounds = [
             stack_log_likelihood_bound(

@@ -8,20 +8,29 @@ from sklearn.utils._param_validation import Interval
 from ..layers._factored import FactoredLayer
 from ..utils._array_api import to_numpy
 from ._base import FittedParameter
+from ._label_factors import blocks
 from ._style import BaseStyleModel
 
 __all__ = ["FactoredCRBM"]
 
 
-def balanced_frames(frames, label_weights):
+def balanced_frames(frames, label_weights, blocks=None):
     """``frames`` with each style's frames repeated to about the most frequent's count.
 
-    A frame's style is its largest label weight; a style with ``n`` frames is
-    repeated ``round(n_max / n)`` times (at least once), as the released code
-    copies the takes of the less frequent styles.  Copies stay next to their
-    frame, so the frames remain in time order.
+    A frame's style is its largest label weight (with several label factors,
+    whose weights fill the ``blocks`` of the columns, its combination of
+    each factor's largest); a style with ``n`` frames is repeated ``round(n_max
+    / n)`` times (at least once), as the released code copies the takes of
+    the less frequent styles.  Copies stay next to their frame, so the
+    frames remain in time order.
     """
-    styles = np.argmax(to_numpy(label_weights)[frames], axis=1)
+    weights = to_numpy(label_weights)[frames]
+    if blocks is None:
+        styles = np.argmax(weights, axis=1)
+    else:
+        codes = [np.argmax(weights[:, block], axis=1) for block in blocks]
+        sizes = [block.stop - block.start for block in blocks]
+        styles = np.ravel_multi_index(codes, sizes)
     counts = np.bincount(styles)
     copies = np.zeros(len(counts), dtype=np.intp)
     present = counts > 0
@@ -330,7 +339,7 @@ class FactoredCRBM(BaseStyleModel):
 
     def _train(self, X, frames, n_epochs, n_averaged=0, context=None):
         if self.balance_styles and self._labelled:
-            frames = balanced_frames(frames, context)
+            frames = balanced_frames(frames, context, blocks(self._factor_classes))
         super()._train(X, frames, n_epochs, n_averaged, context)
 
     def _new_layer(self, n_features, n_context, dtype):
