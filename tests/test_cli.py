@@ -496,7 +496,12 @@ def test_styles_missing_data_says_how_to_fetch(tmp_path, capsys):
 
 def test_fetch_downloads_the_data_sets_asked_for(tmp_path, capsys, monkeypatch):
     fetched = []
-    for name in ("fetch_cmu35", "fetch_mit_walk", "fetch_bandai_walks"):
+    for name in (
+        "fetch_cmu35",
+        "fetch_mit_walk",
+        "fetch_bandai_walks",
+        "fetch_bandai_dataset2",
+    ):
         monkeypatch.setattr(_cli, name, lambda home, name=name: fetched.append(name))
     home = ["--data-home", str(tmp_path)]
     assert main(["fetch", *home]) == 0
@@ -507,6 +512,9 @@ def test_fetch_downloads_the_data_sets_asked_for(tmp_path, capsys, monkeypatch):
     fetched.clear()
     assert main(["fetch", "--dataset", "bandai", "--dataset", "cmu35", *home]) == 0
     assert fetched == ["fetch_bandai_walks", "fetch_cmu35"]
+    fetched.clear()
+    assert main(["fetch", "--dataset", "bandai-dataset2", *home]) == 0
+    assert fetched == ["fetch_bandai_dataset2"]
 
 
 # -- errors in the command's terms; a user's labelled folder (issue 38) ------

@@ -18,6 +18,7 @@ import sklearn
 from sklearn.utils import Bunch
 
 from ..datasets import (
+    fetch_bandai_dataset2,
     fetch_bandai_walks,
     fetch_cmu35,
     fetch_mit_walk,
@@ -149,6 +150,7 @@ def run_fetch(args):
         "cmu35": fetch_cmu35,
         "mit": fetch_mit_walk,
         "bandai": fetch_bandai_walks,
+        "bandai-dataset2": fetch_bandai_dataset2,
     }
     print(f"downloading into {home}")
     try:

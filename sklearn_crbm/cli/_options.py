@@ -249,11 +249,14 @@ COMMANDS = {
             _option(
                 "--dataset",
                 action="append",
-                choices=["cmu35", "mit", "bandai"],
+                choices=["cmu35", "mit", "bandai", "bandai-dataset2"],
                 help="download this data set (repeat for several): cmu35, "
-                "mit (Taylor's MIT walking data) or bandai (the Bandai Namco "
+                "mit (Taylor's MIT walking data), bandai (the Bandai Namco "
                 "walks in seven styles, 15 MB, CC BY-NC 4.0, for the styles "
-                "command); default: cmu35 and mit",
+                "command) or bandai-dataset2 (the Bandai Namco corpus of ten "
+                "contents in seven styles, takes 001-012, 840 takes with "
+                "content and style labels, 174 MB, CC BY-NC 4.0, for 'fit "
+                "--labels content,style'); default: cmu35 and mit",
             ),
         ],
     ),
