@@ -11,6 +11,7 @@ import re
 import shutil
 import sys
 import warnings
+from pathlib import Path
 
 import joblib
 import numpy as np
@@ -29,6 +30,7 @@ from ..datasets import (
     read_bvh_folder,
     resample_frames,
 )
+from ..datasets._labels import file_labels
 from ..exceptions import GenerationWarning
 from ..metrics._liveliness import (
     DEAD_FRACTION,
@@ -463,7 +465,9 @@ def _seeds(saved, args):
 def run_styles(args):
     if args.folder is not None:
         walks = _read_motion_folder(args.folder, args.frame_rate, args.labels)
-        walks.name = f"the motion in {args.folder}"
+        walks.noun = _content_noun(args.folder, walks)
+        kind = "" if walks.noun == "take" else f"{walks.noun} "
+        walks.name = f"the {kind}takes in {args.folder}"
     else:
         walks = _load(
             load_bandai_walks,
@@ -472,6 +476,7 @@ def run_styles(args):
             " --dataset bandai",
         )
         walks.name = "Bandai Namco walks"
+        walks.noun = "walk"
     model = FactoredCRBM(
         args.n_components,
         n_factors=args.n_factors,
@@ -484,6 +489,18 @@ def run_styles(args):
     )
     _check_order(args.order, walks)
     return _run_styles(args, walks, model)
+
+
+def _content_noun(folder, data):
+    """What the takes of a folder are: the one content of their JSON labels
+    (``"wave-left-hand"``, as the Bandai Namco files name it), else "take"."""
+    paths = [Path(name) for name in data.filenames]
+    try:
+        codes, names = file_labels(folder, paths, "content")
+    except (OSError, ValueError, TypeError):  # no content labels
+        return "take"
+    contents = set(names[codes].tolist())
+    return contents.pop() if len(contents) == 1 else "take"
 
 
 _RUNS = {

@@ -380,18 +380,20 @@ COMMANDS = {
         "many styles from one factored CRBM: BVH files, strips, a judge",
         "Train a FactoredCRBM (Taylor & Hinton, ICML 2009) on the Bandai "
         "Namco walks in seven styles (or on a labelled folder of your own, "
-        "--folder and --labels), generate a walk in every style, a "
+        "--folder and --labels), generate every style, a "
         "50/50 blend of two styles and a transition from one style to "
-        "another half-way, all seeded with real frames of a normal walk, "
+        "another half-way, all seeded with real frames of one style, "
         "and write them as BVH files with a skeleton strip of each, a "
         "plot of the style judge's probabilities over the transition, and "
         "GIFs of every style moving side by side and of the transition over "
         "the judge's probabilities. "
         "Prints a table of how a StyleJudge trained on the real takes sees "
         "every style: the share of 2-s windows judged as the style asked "
-        "for, and the leg amplitude and step frequency against the real "
-        "takes. The defaults train for several minutes; fetch the data "
-        "first with 'fetch --dataset bandai'.",
+        "for, and the amplitude and frequency of the joints that move most "
+        "in the real takes (the legs of a walk, the arm of a wave) against "
+        "theirs, beside the judge's verdict on the real takes. The defaults "
+        "train for several minutes; fetch the data first with 'fetch "
+        "--dataset bandai'.",
         [
             _DATA_HOME,
             _option(
