@@ -532,6 +532,9 @@ def test_fetch_downloads_the_data_sets_asked_for(tmp_path, capsys, monkeypatch):
         (["sample", "m.joblib", "--speed", "fast"], "argument --speed: must be a"),
         (["sample", "m.joblib", "--speed", "1:2:3"], "argument --speed: must be a"),
         (["sample", "m.joblib", "--speed", "nan"], "argument --speed: must be fin"),
+        (["sample", "m", "--n-mean-field", "0"], "argument --n-mean-field: must be"),
+        (["fit", "--hidden-drift", "-1"], "argument --hidden-drift: must be at le"),
+        (["styles", "--hidden-drift", "x"], "argument --hidden-drift: must be a nu"),
     ],
 )
 def test_bad_counts_are_named_by_their_flags(argv, message, capsys):
@@ -790,6 +793,61 @@ def test_sample_says_once_that_a_sequence_came_to_rest(walker_model, tmp_path, c
     assert err == ""  # no warning saying it again
     assert "--seed-file PATH --seed-frame N" in out
     assert "history=" not in out
+
+
+def test_fit_saves_the_sampler_parameters_and_sample_overrides_them(
+    walker_model, tmp_path, capsys, monkeypatch
+):
+    """n_mean_field and hidden_drift, which only sample reads, from the
+    command line (issue 46): fit saves them in the model, sample passes
+    its own to the pipeline's sample for this run only."""
+    _, folder = walker_model
+    model = tmp_path / "m.joblib"
+    argv = ["fit", str(folder), *TINY, "--output", str(model)]
+    assert main([*argv, "--n-mean-field", "2", "--hidden-drift", "0.05"]) == 0
+    crbm = _cli._load_model(model).pipeline[-1]
+    assert (crbm.n_mean_field, crbm.hidden_drift) == (2, 0.05)
+    asked = []
+    original = _cli.MotionPipeline.sample
+
+    def spy(self, n_frames, **params):
+        asked.append(
+            {k: params[k] for k in ("n_mean_field", "hidden_drift") if k in params}
+        )
+        return original(self, n_frames, **params)
+
+    monkeypatch.setattr(_cli.MotionPipeline, "sample", spy)
+    take = folder / "walk_fast_001.bvh"  # one seed for both sequences
+    argv = ["sample", str(model), "--n-frames", "40", "--n-sequences", "2"]
+    argv += ["--seed-file", str(take), "--output", str(tmp_path / "out")]
+    drawn = {}
+    for name, extra in [
+        ("saved", []),
+        ("copies", ["--n-mean-field", "30", "--hidden-drift", "0"]),
+        ("apart", ["--n-mean-field", "1", "--hidden-drift", "2"]),
+    ]:
+        assert main([*argv, *extra]) == 0, capsys.readouterr().err
+        drawn[name] = [
+            read_bvh(tmp_path / "out" / f"generated_{k}.bvh")[1] for k in (0, 1)
+        ]
+    assert asked == [
+        {},
+        {"n_mean_field": 30, "hidden_drift": 0.0},
+        {"n_mean_field": 1, "hidden_drift": 2.0},
+    ]
+    gap = {name: np.abs(a - b).mean() for name, (a, b) in drawn.items()}
+    assert gap["copies"] < gap["apart"], gap
+
+
+def test_styles_sampler_options_reach_the_factored_model(monkeypatch, tmp_path):
+    models = []
+    monkeypatch.setattr(
+        _cli, "_run_styles", lambda args, walks, model: models.append(model) or 0
+    )
+    folder = _walker_folder(tmp_path / "mine", 30.0, n_frames=30)
+    argv = ["styles", "--folder", str(folder), "--n-mean-field", "3"]
+    assert main([*argv, "--hidden-drift", "0.2"]) == 0
+    assert (models[0].n_mean_field, models[0].hidden_drift) == (3, 0.2)
 
 
 def test_sample_seeds_from_a_take_of_ones_own(walker_model, tmp_path, capsys):

@@ -115,6 +115,8 @@ def _model_from_args(args):
         history_noise=args.history_noise,
         history_noise_fraction=args.history_noise_fraction,
         average_fraction=args.average_fraction,
+        n_mean_field=args.n_mean_field,
+        hidden_drift=args.hidden_drift,
         random_state=args.seed,
         verbose=max(1, (1000 if args.n_iter == "auto" else args.n_iter) // 10),
     )
@@ -348,6 +350,7 @@ def run_sample(args):
             n_sequences=args.n_sequences,
             hidden_noise=args.hidden_noise,
             random_state=args.seed,
+            **_sampler_request(args),
             **_speed_request(saved, args),
         )
     suffixes = [".bvh"] + [".amc"] * (pipeline.skeleton.convention == "acclaim")
@@ -378,6 +381,13 @@ def run_sample(args):
         )
         print(f"wrote {path.name}")
     return 0
+
+
+def _sampler_request(args):
+    """``sample``'s ``--n-mean-field`` and ``--hidden-drift`` where given
+    (left out, the saved model's own parameters)."""
+    asked = dict(n_mean_field=args.n_mean_field, hidden_drift=args.hidden_drift)
+    return {name: value for name, value in asked.items() if value is not None}
 
 
 def _speed_request(saved, args):
@@ -484,6 +494,8 @@ def run_styles(args):
         order=args.order,
         n_iter=args.n_iter,
         n_gibbs=args.n_gibbs,
+        n_mean_field=args.n_mean_field,
+        hidden_drift=args.hidden_drift,
         random_state=args.seed,
         verbose=max(1, args.n_iter // 10),
     )

@@ -60,6 +60,31 @@ def _count(minimum):
 _rate = _checked(
     float, "a number of frames per second", lambda r: 0 < r < math.inf, "positive"
 )
+_non_negative = _checked(float, "a number", lambda x: 0 <= x < math.inf, "at least 0")
+
+
+def _sampler_options(defaults, what):
+    """``--n-mean-field`` and ``--hidden-drift``: parameters that only
+    sampling reads, with ``defaults``' values (None: the saved model's)."""
+    default = "the saved model's own" if defaults is None else None
+    return [
+        _option(
+            "--n-mean-field",
+            type=_count(1),
+            default=None if defaults is None else defaults.n_mean_field,
+            help=f"mean-field steps that end every generated frame{what}: more "
+            "is smoother, fewer lets the sequences drawn from one seed differ"
+            + (f" (default: {default})" if default else ""),
+        ),
+        _option(
+            "--hidden-drift",
+            type=_non_negative,
+            default=None if defaults is None else defaults.hidden_drift,
+            help="standard deviation of a smooth random offset of the hidden "
+            f"biases that keeps the sequences drawn from one seed apart{what}; "
+            "0: none" + (f" (default: {default})" if default else ""),
+        ),
+    ]
 
 
 def _speed_request(text):
@@ -156,6 +181,7 @@ _MODEL_OPTIONS = [
         help="training epochs (the paper: 4000); auto: enough for 25,000 "
         "minibatch updates, at least 1000",
     ),
+    *_sampler_options(_DEFAULTS, ", saved with the model"),
     _SEED,
 ]
 _FACTORED_OPTIONS = [
@@ -195,6 +221,7 @@ _FACTORED_OPTIONS = [
         default=_FACTORED.n_gibbs,
         help="Gibbs iterations per generated frame",
     ),
+    *_sampler_options(_FACTORED, ""),
     _SEED,
 ]
 
@@ -356,6 +383,7 @@ COMMANDS = {
                 "at every frame: 0 follows the model's own dynamics, more noise "
                 "lets the motion switch styles (paper §4.3)",
             ),
+            *_sampler_options(None, ""),
             _option(
                 "--seed",
                 type=int,
