@@ -39,9 +39,17 @@ from ..metrics._liveliness import (
 )
 from ..models._crbm import ConditionalRBM
 from ..models._factored import FactoredCRBM
+from ..models._labelled import LabelledCRBM
 from ..preprocessing import MotionContext, MotionPipeline, make_motion_pipeline
 from ._demo import liveliness_text, save_gif
 from ._demo import run_demo as _run_demo
+from ._labels import (
+    label_keys,
+    label_request,
+    label_text,
+    read_several_labels,
+    seed_windows_for,
+)
 from ._options import COMMANDS, MAX_DEFAULT_RATE
 from ._seed_file import seed_from_file
 from ._style_demo import run_styles as _run_styles
@@ -106,9 +114,11 @@ class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
         return super()._get_help_string(action)
 
 
-def _model_from_args(args):
-    """The ConditionalRBM that ``demo`` and ``fit`` train, from the model options."""
-    return ConditionalRBM(
+def _model_from_args(args, labelled=False):
+    """The ConditionalRBM that ``demo`` and ``fit`` train, from the model
+    options; a LabelledCRBM of the same options for ``fit --labels`` with
+    several keys."""
+    return (LabelledCRBM if labelled else ConditionalRBM)(
         args.n_components,
         order=args.order,
         n_iter=args.n_iter,
@@ -170,17 +180,29 @@ def run_fetch(args):
 
 def run_fit(args):
     data, styles = _training_data(args)
+    several = styles is not None and styles.ndim == 2
     n = len(data.sequence_names)
     print(
         f"training on {len(data.data)} frames of {n} sequence{'s' * (n != 1)} "
         f"at {data.frame_rate:g} frames/s"
-        + (f", labels {', '.join(dict.fromkeys(styles))}" if args.labels else "")
+        + (f", labels {_labels_summary(data, styles)}" if args.labels else "")
     )
+    if several and args.speed_context:
+        raise ValueError(
+            "--speed-context trains with speed as the model's context, several "
+            "--labels with the labels: give one of the two."
+        )
     _check_order(args.order, data)
-    pipeline = make_motion_pipeline(data.skeleton, _model_from_args(args))
+    pipeline = make_motion_pipeline(
+        data.skeleton, _model_from_args(args, labelled=several)
+    )
     speed = _speed_context(data, styles) if args.speed_context else {}
     context = {"context": speed.pop("speeds")} if speed else {}
-    pipeline.fit(data.data, sequence_ids=data.sequence_ids, **context)
+    if several:  # one model of every label: a factor per key
+        pipeline.fit(data.data, styles, sequence_ids=data.sequence_ids)
+        styles = np.array([label_text(row) for row in styles])
+    else:
+        pipeline.fit(data.data, sequence_ids=data.sequence_ids, **context)
     windows = {}
     if styles is not None:
         windows = pipeline.style_windows(
@@ -190,12 +212,31 @@ def run_fit(args):
             n_windows=N_STYLE_WINDOWS,
             random_state=args.seed,
         )
+    keys = {"label_keys": data.label_keys} if several else {}
     saved = Bunch(
-        pipeline=pipeline, seed_windows=windows, frame_rate=data.frame_rate, **speed
+        pipeline=pipeline,
+        seed_windows=windows,
+        frame_rate=data.frame_rate,
+        **keys,
+        **speed,
     )
     joblib.dump(dict(saved), args.output)
     print(f"saved the fitted pipeline to {args.output}")
     return 0
+
+
+def _labels_summary(data, labels):
+    """``"fast, slow"``, or for several keys ``"content: run, walk; style:
+    elderly, normal (3 of their 4 combinations)"``."""
+    if labels.ndim == 1:
+        return ", ".join(dict.fromkeys(labels))
+    names = [
+        f"{key}: {', '.join(map(str, known))}"
+        for key, known in zip(data.label_keys, data.target_names, strict=True)
+    ]
+    seen = len({tuple(row) for row in labels.tolist()})
+    possible = int(np.prod([len(known) for known in data.target_names]))
+    return f"{'; '.join(names)} ({seen} of their {possible} combinations)"
 
 
 def _speed_context(data, styles):
@@ -234,6 +275,8 @@ def _training_data(args):
     data = _read_motion_folder(args.folder, args.frame_rate, args.labels)
     if args.labels is None:
         return data, None
+    if "label_keys" in data:  # several: the names themselves
+        return data, data.target
     return data, data.target_names[data.target]
 
 
@@ -243,7 +286,9 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
     ``frame_rate`` None: the files' own rate, brought down to
     ``MAX_DEFAULT_RATE`` when faster.  ``labels``: see ``fit --labels``; the
     label names are text, as typed after ``--style`` (also labels that are
-    numbers).
+    numbers).  With several keys, ``target`` holds every frame's names,
+    one column per key, ``target_names`` the names of each key and
+    ``label_keys`` the keys.
     """
     if not folder.is_dir():
         raise FileNotFoundError(f"{folder} is not a folder.")
@@ -256,7 +301,9 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
             f"{folder} holds no *.bvh or *.amc file: the command reads a folder "
             "of BVH files, or of AMC files with their ASF skeleton."
         )
-    labels = _label_source(labels)
+    keys = label_keys(labels)
+    several = keys is not None and len(keys) > 1
+    labels = None if several else _label_source(labels)
     try:
         data = read(folder, frame_rate=frame_rate, labels=labels)
     except ValueError as exc:
@@ -269,6 +316,11 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
             "sets the rate to train at: at most the slowest file's (leave it out to "
             "train at the files' own rate)."
         ) from None
+    if several:
+        data.target = read_several_labels(folder, data, keys)
+        data.target_names = [np.unique(column) for column in data.target.T]
+        data.label_keys = keys
+        _check_label_names(data)
     if frame_rate is None and data.frame_rate > MAX_DEFAULT_RATE:
         keep = resample_frames(
             np.arange(len(data.data)),
@@ -283,6 +335,18 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
     if labels is not None:
         data.target_names = np.array([str(name) for name in data.target_names])
     return data
+
+
+def _check_label_names(data):
+    """Names that ``sample --label`` can give back: no comma in any."""
+    for key, names in zip(data.label_keys, data.target_names, strict=True):
+        odd = [name for name in names if "," in name]
+        if odd:
+            raise ValueError(
+                f"the {key} label {odd[0]!r} holds a comma, which separates the "
+                "labels of 'sample --label'; rename the labels in the label "
+                "files."
+            )
 
 
 def _label_source(labels):
@@ -340,7 +404,8 @@ def _load_model(path):
 def run_sample(args):
     saved = _load_model(args.model)
     pipeline = saved.pipeline
-    history, seeded = _seeds(saved, args)
+    request = _label_request(saved, args)
+    history, seeded = _seeds(saved, args, request)
     with warnings.catch_warnings():
         # every sequence's verdict is printed beside its file, once
         warnings.simplefilter("ignore", GenerationWarning)
@@ -350,6 +415,7 @@ def run_sample(args):
             n_sequences=args.n_sequences,
             hidden_noise=args.hidden_noise,
             random_state=args.seed,
+            **({} if request is None else {"y": request}),
             **_sampler_request(args),
             **_speed_request(saved, args),
         )
@@ -381,6 +447,33 @@ def run_sample(args):
         )
         print(f"wrote {path.name}")
     return 0
+
+
+def _label_request(saved, args):
+    """``sample --label``: one label per key of a model fitted on several
+    (``fit --labels content,style``), checked; None for any other model."""
+    keys = saved.get("label_keys")
+    if keys is None:
+        if args.label is not None:
+            raise ValueError(
+                f"--label asks for labels of a model fitted on several (fit "
+                f"--labels content,style); {args.model} was not: seed it with "
+                "real frames of a label with --style."
+            )
+        return None
+    if args.style is not None:
+        raise ValueError(
+            f"{args.model} was fitted on the labels {', '.join(keys)}: ask for "
+            f"them with --label (such as --label {next(iter(saved.seed_windows))}), "
+            "not --style."
+        )
+    if args.label is None:
+        raise ValueError(
+            f"{args.model} was fitted on the labels {', '.join(keys)}: say which "
+            f"to generate with --label, one of each (such as --label "
+            f"{next(iter(saved.seed_windows))})."
+        )
+    return label_request(args.label, keys, saved.pipeline[-1].classes_)
 
 
 def _sampler_request(args):
@@ -442,9 +535,11 @@ def _verdicts(pipeline, raw, n_frames):
     return verdicts, failed
 
 
-def _seeds(saved, args):
+def _seeds(saved, args, request=None):
     """``sample``'s history and what it is: saved windows of the chosen
-    style, frames of ``--seed-file``, or None (the model's own windows)."""
+    style or labels (``request``), frames of ``--seed-file``, or None (the
+    model's own windows)."""
+    asked = "" if request is None else f"{label_text(request)}, "
     if args.seed_frame is not None and args.seed_file is None:
         raise ValueError("--seed-frame N picks a frame of --seed-file PATH: give both.")
     if args.seed_file is not None:
@@ -456,7 +551,14 @@ def _seeds(saved, args):
             saved.pipeline, saved.frame_rate, args.seed_file, args.seed_frame
         )
         history = np.repeat(seed.window[None], args.n_sequences, axis=0)
-        return history, f"seeded with {seed.text}"
+        return history, f"{asked}seeded with {seed.text}"
+    rng = np.random.default_rng(args.seed)
+    if request is not None:
+        windows, name = seed_windows_for(saved.seed_windows, request)
+        if windows is None:
+            return None, f"{asked}seeded with training frames"
+        chosen = windows[rng.integers(len(windows), size=args.n_sequences)]
+        return chosen, f"{asked}seeded with {name} frames"
     if args.style is None:
         return None, "seeded with training frames"
     if args.style not in saved.seed_windows:
@@ -467,12 +569,18 @@ def _seeds(saved, args):
             "sequence, or seed from a take of your own with --seed-file."
         )
     windows = saved.seed_windows[args.style]
-    rng = np.random.default_rng(args.seed)
     chosen = windows[rng.integers(len(windows), size=args.n_sequences)]
     return chosen, f"seeded with {args.style} frames"
 
 
 def run_styles(args):
+    keys = label_keys(args.labels)
+    if args.folder is not None and len(keys) > 1:
+        raise ValueError(
+            f"--labels {args.labels}: the styles command models one label (a "
+            "style); to model several, train with 'fit FOLDER --labels "
+            f"{args.labels}' and generate with 'sample MODEL --label ...'."
+        )
     if args.folder is not None:
         walks = _read_motion_folder(args.folder, args.frame_rate, args.labels)
         walks.noun = _content_noun(args.folder, walks)

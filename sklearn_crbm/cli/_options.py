@@ -315,7 +315,10 @@ COMMANDS = {
                 "file ('style' reads walk_001.json's {\"style\": 2}, named by "
                 "style_label.txt when there is one), or a regular expression "
                 "with a group, matched against each file's name "
-                "('walk_([a-z]+)_' labels walk_proud_01.bvh 'proud')",
+                "('walk_([a-z]+)_' labels walk_proud_01.bvh 'proud'); several "
+                "keys separated by commas ('content,style') train one "
+                "LabelledCRBM of all of them, one label factor per key, that "
+                "'sample --label run,elderly' asks for any combination",
             ),
             _option(
                 "--speed-context",
@@ -346,6 +349,15 @@ COMMANDS = {
                 help="seed each sequence with real frames of this style ('walk' "
                 "or 'jog' for CMU 35); default: the model's own seed windows, "
                 "from every training sequence",
+            ),
+            _option(
+                "--label",
+                metavar="LABEL,LABEL",
+                help="for a model fitted on several labels ('fit --labels "
+                "content,style'): the labels of the generated motion, one per "
+                "key in their order, such as run,elderly; any combination, "
+                "also one the training takes lack (seeded then with frames "
+                "of the nearest labels)",
             ),
             _option(
                 "--seed-file",
