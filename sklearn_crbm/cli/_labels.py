@@ -7,19 +7,9 @@ and ``sample --label run,elderly`` asks it for any combination, also one it
 never saw.  This module reads and checks the labels; the model does the rest.
 """
 
-from pathlib import Path
-
 import numpy as np
 
-from ..datasets._labels import file_labels
-
-__all__ = [
-    "label_keys",
-    "label_request",
-    "label_text",
-    "read_several_labels",
-    "seed_windows_for",
-]
+__all__ = ["label_keys", "label_request", "label_text", "seed_windows_for"]
 
 
 def label_keys(text):
@@ -39,24 +29,9 @@ def label_keys(text):
     return keys
 
 
-def read_several_labels(folder, data, keys):
-    """Every frame's label of each key: ``(n_frames, len(keys))`` names.
-
-    ``data`` is the folder as read (its ``filenames`` and ``sequence_ids``);
-    each key is read from the JSON file beside every take, named by
-    ``{key}_label.txt`` where there is one (without the prefix every name
-    shares), as :func:`~sklearn_crbm.datasets.read_bvh_folder` reads one.
-    """
-    paths = [Path(name) for name in data.filenames]
-    per_take = np.empty((len(paths), len(keys)), dtype=object)
-    for k, key in enumerate(keys):
-        codes, names = file_labels(Path(folder), paths, key)
-        per_take[:, k] = [str(name) for name in names[codes]]
-    return per_take[data.sequence_ids]
-
-
 def label_text(labels):
-    """The names of one frame's labels as ``sample --label`` takes them."""
+    """The names of one frame's labels (a tuple, one per key) as ``sample
+    --label`` takes them: ``"run,elderly"``."""
     return ",".join(str(label) for label in labels)
 
 
@@ -97,30 +72,29 @@ def label_request(text, keys, classes):
 def seed_windows_for(windows, request):
     """The saved seed windows nearest to the labels asked for, and what they are.
 
-    ``windows`` maps :func:`label_text` of the training labels to real
-    windows.  Those of exactly the labels asked for when the training takes
+    ``windows`` maps the training labels (a tuple, one per key) to real
+    windows, as :meth:`~sklearn_crbm.preprocessing.MotionPipeline.style_windows`
+    keeps them.  Those of exactly the labels asked for when the training takes
     had them; otherwise all those that share the most labels with them, the
     first key's label (the content) first: an elderly run never seen starts
     from the runs of every other style.  ``(None, None)`` when no saved
     label shares any.
     """
-    request = list(request)
-    name = label_text(request)
-    if name in windows:
-        return windows[name], name
+    request = tuple(request)
+    if request in windows:
+        return windows[request], label_text(request)
 
-    def shared(text):
-        labels = text.split(",")
+    def shared(labels):
         return (
             labels[0] == request[0],
             sum(a == b for a, b in zip(labels, request, strict=True)),
         )
 
-    best = max((shared(text) for text in windows), default=(False, 0))
+    best = max((shared(labels) for labels in windows), default=(False, 0))
     if best == (False, 0):
         return None, None
-    nearest = [text for text in windows if shared(text) == best]
-    named = " or ".join(nearest[:2])
+    nearest = [labels for labels in windows if shared(labels) == best]
+    named = " or ".join(label_text(labels) for labels in nearest[:2])
     if len(nearest) > 2:
         named += f" or {len(nearest) - 2} more"
-    return np.concatenate([windows[text] for text in nearest]), named
+    return np.concatenate([windows[labels] for labels in nearest]), named

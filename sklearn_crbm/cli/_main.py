@@ -47,7 +47,6 @@ from ._labels import (
     label_keys,
     label_request,
     label_text,
-    read_several_labels,
     seed_windows_for,
 )
 from ._options import COMMANDS, MAX_DEFAULT_RATE
@@ -200,7 +199,6 @@ def run_fit(args):
     context = {"context": speed.pop("speeds")} if speed else {}
     if several:  # one model of every label: a factor per key
         pipeline.fit(data.data, styles, sequence_ids=data.sequence_ids)
-        styles = np.array([label_text(row) for row in styles])
     else:
         pipeline.fit(data.data, sequence_ids=data.sequence_ids, **context)
     windows = {}
@@ -303,7 +301,7 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
         )
     keys = label_keys(labels)
     several = keys is not None and len(keys) > 1
-    labels = None if several else _label_source(labels)
+    labels = keys if several else _label_source(labels)
     try:
         data = read(folder, frame_rate=frame_rate, labels=labels)
     except ValueError as exc:
@@ -317,8 +315,7 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
             "train at the files' own rate)."
         ) from None
     if several:
-        data.target = read_several_labels(folder, data, keys)
-        data.target_names = [np.unique(column) for column in data.target.T]
+        data.target_names = [names.astype(str) for names in data.target_names]
         data.label_keys = keys
         _check_label_names(data)
     if frame_rate is None and data.frame_rate > MAX_DEFAULT_RATE:
@@ -332,7 +329,7 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
             if key in data:
                 data[key] = data[key][keep]
         data.frame_rate = MAX_DEFAULT_RATE
-    if labels is not None:
+    if labels is not None and not several:
         data.target_names = np.array([str(name) for name in data.target_names])
     return data
 
@@ -340,7 +337,7 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
 def _check_label_names(data):
     """Names that ``sample --label`` can give back: no comma in any."""
     for key, names in zip(data.label_keys, data.target_names, strict=True):
-        odd = [name for name in names if "," in name]
+        odd = [str(name) for name in names if "," in name]
         if odd:
             raise ValueError(
                 f"the {key} label {odd[0]!r} holds a comma, which separates the "
@@ -464,16 +461,22 @@ def _label_request(saved, args):
     if args.style is not None:
         raise ValueError(
             f"{args.model} was fitted on the labels {', '.join(keys)}: ask for "
-            f"them with --label (such as --label {next(iter(saved.seed_windows))}), "
+            f"them with --label (such as --label {_a_label(saved)}), "
             "not --style."
         )
     if args.label is None:
         raise ValueError(
             f"{args.model} was fitted on the labels {', '.join(keys)}: say which "
             f"to generate with --label, one of each (such as --label "
-            f"{next(iter(saved.seed_windows))})."
+            f"{_a_label(saved)})."
         )
     return label_request(args.label, keys, saved.pipeline[-1].classes_)
+
+
+def _a_label(saved):
+    """The labels of the first seed windows a model of several labels keeps,
+    as ``sample --label`` takes them."""
+    return label_text(next(iter(saved.seed_windows)))
 
 
 def _sampler_request(args):

@@ -14,9 +14,8 @@ from ._bandai import (
     dataset2_selection,
 )
 from ._bvh import read_bvh
-from ._folders import _long_format, read_bvh_folder
+from ._folders import _long_format, _with_labels, read_bvh_folder
 from ._frame_rate import kept_frames
-from ._labels import file_labels
 from ._mit import load_mit_mat
 from ._parsing import load_mat_variables
 from ._skeleton import Skeleton
@@ -434,18 +433,9 @@ def load_bandai_dataset2(data_home=None, *, contents=None, styles=None, takes=No
         skeleton, data, _, rate = read_bvh(path)
         sequences.append((path, skeleton, data, rate))
     corpus = _long_format(folder, sequences, FRAME_RATE, "BVH")
-    columns, names = [], []
-    for key in DATASET2_LABELS:
-        codes, label_names = file_labels(folder, paths, key)
-        columns.append(label_names[codes])
-        present = np.unique(codes)
-        names.append(label_names[present])
-    target = np.empty((len(paths), len(DATASET2_LABELS)), dtype=object)
-    target[:] = np.column_stack(columns)
+    corpus = _with_labels(corpus, folder, paths, list(DATASET2_LABELS), None)
     corpus.update(
-        target=target[corpus.sequence_ids],
         target_columns=DATASET2_LABELS,
-        target_names=names,
         takes=np.array([int(name[-3:]) for name in corpus.sequence_names]),
         DESCR=DATASET2_DESCR,
     )
