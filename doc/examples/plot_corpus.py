@@ -62,7 +62,7 @@ try:
     X, y, ids = corpus.data, corpus.target, corpus.sequence_ids
     skeleton, frame_rate = corpus.skeleton, corpus.frame_rate
     contents, styles = (list(names) for names in corpus.target_names)
-    held_out, seed = ("run", "elderly"), "walk,normal"
+    held_out, seed = ("run", "elderly"), ("walk", "normal")
 except FileNotFoundError:
     walker = make_walker(n_sequences=12, n_frames=150, random_state=0)
     X, ids = walker.data, walker.sequence_ids
@@ -74,11 +74,9 @@ except FileNotFoundError:
     style = np.where(strides > np.median(strides), "long", "short")
     y = np.column_stack([content, style])[ids]
     contents, styles = ["slow", "brisk"], ["short", "long"]
-    held_out, seed = ("brisk", "long"), "slow,short"
-pairs = np.array([f"{content},{style}" for content, style in y])
-print(
-    f"{len(X)} frames in {len(np.unique(ids))} takes; cells: {sorted(set(pairs.tolist()))}"
-)
+    held_out, seed = ("brisk", "long"), ("slow", "short")
+cells = sorted({tuple(labels) for labels in y.tolist()})
+print(f"{len(X)} frames in {len(np.unique(ids))} takes; cells: {cells}")
 
 # %%
 # Fit one model of every content and style, one cell held out
@@ -95,10 +93,11 @@ print("labels of each factor:", [names.tolist() for names in model.classes_])
 # Generate every cell from the same seed
 # --------------------------------------
 # ``y=(content, style)`` asks for one pair for all the generated frames; the
-# seed is real frames of the seed cell, drawn from the training takes.
+# seed is real frames of the seed cell, drawn from the training takes
+# (``style_windows`` keys the windows of a 2-D ``y`` by the tuple of labels).
 n_frames = 240
 seeds = pipe.style_windows(
-    X[train], pairs[train], sequence_ids=ids[train], n_windows=1, random_state=0
+    X[train], y[train], sequence_ids=ids[train], n_windows=1, random_state=0
 )[seed]
 generated = {
     (content, style): pipe.sample(
