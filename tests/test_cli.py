@@ -19,6 +19,7 @@ from sklearn_crbm.cli import _main as _cli
 from sklearn_crbm.cli import _style_demo, main
 from sklearn_crbm.datasets import (
     bone_columns,
+    load_bandai_dataset2,
     load_bandai_walks,
     load_cmu35,
     make_walker,
@@ -383,12 +384,12 @@ def _read_raw_channels(path, walks):
     return raw
 
 
-def _table_rows(out):
+def _table_rows(out, styles=STYLES):
     """``{style: row}`` of the printed table, numbers parsed."""
     rows = {}
     for line in out.splitlines():
         words = line.replace("%", "").replace("(", "").replace(")", "").split()
-        if len(words) == 6 and words[0] in STYLES:
+        if len(words) == 6 and words[0] in styles:
             rows[words[0]] = [float(w.replace("-", "nan")) for w in words[1:]]
     return rows
 
@@ -401,8 +402,8 @@ def test_styles_table_is_the_judge_on_the_written_files(styles_run, data_home):
     with sklearn.config_context(enable_metadata_routing=True):
         pre = make_motion_preprocessor(walks.skeleton)
         Z = pre.fit_transform(walks.data, sequence_ids=walks.sequence_ids)
-    legs = bone_columns(pre.get_feature_names_out(), _style_demo.LEGS)
-    judge = StyleJudge(legs=legs).fit(Z, labels, sequence_ids=walks.sequence_ids)
+    moving = _style_demo.moving_joint_channels(pre, Z, walks.sequence_ids)
+    judge = StyleJudge(legs=moving).fit(Z, labels, sequence_ids=walks.sequence_ids)
     rows = _table_rows(out)
     assert sorted(rows) == STYLES
     for k, style in enumerate(STYLES):
@@ -496,7 +497,12 @@ def test_styles_missing_data_says_how_to_fetch(tmp_path, capsys):
 
 def test_fetch_downloads_the_data_sets_asked_for(tmp_path, capsys, monkeypatch):
     fetched = []
-    for name in ("fetch_cmu35", "fetch_mit_walk", "fetch_bandai_walks"):
+    for name in (
+        "fetch_cmu35",
+        "fetch_mit_walk",
+        "fetch_bandai_walks",
+        "fetch_bandai_dataset2",
+    ):
         monkeypatch.setattr(_cli, name, lambda home, name=name: fetched.append(name))
     home = ["--data-home", str(tmp_path)]
     assert main(["fetch", *home]) == 0
@@ -507,6 +513,9 @@ def test_fetch_downloads_the_data_sets_asked_for(tmp_path, capsys, monkeypatch):
     fetched.clear()
     assert main(["fetch", "--dataset", "bandai", "--dataset", "cmu35", *home]) == 0
     assert fetched == ["fetch_bandai_walks", "fetch_cmu35"]
+    fetched.clear()
+    assert main(["fetch", "--dataset", "bandai-dataset2", *home]) == 0
+    assert fetched == ["fetch_bandai_dataset2"]
 
 
 # -- errors in the command's terms; a user's labelled folder (issue 38) ------
@@ -523,6 +532,9 @@ def test_fetch_downloads_the_data_sets_asked_for(tmp_path, capsys, monkeypatch):
         (["sample", "m.joblib", "--speed", "fast"], "argument --speed: must be a"),
         (["sample", "m.joblib", "--speed", "1:2:3"], "argument --speed: must be a"),
         (["sample", "m.joblib", "--speed", "nan"], "argument --speed: must be fin"),
+        (["sample", "m", "--n-mean-field", "0"], "argument --n-mean-field: must be"),
+        (["fit", "--hidden-drift", "-1"], "argument --hidden-drift: must be at le"),
+        (["styles", "--hidden-drift", "x"], "argument --hidden-drift: must be a nu"),
     ],
 )
 def test_bad_counts_are_named_by_their_flags(argv, message, capsys):
@@ -589,7 +601,8 @@ def test_styles_runs_on_a_users_labelled_folder(tmp_path, capsys):
     argv += ["--order", "2", "--n-sequences", "1"]
     assert main(argv) == 0, capsys.readouterr().err
     out = capsys.readouterr().out
-    assert f"the motion in {folder}: 900 frames in 6 takes" in out
+    assert f"the takes in {folder}: 900 frames in 6 takes" in out
+    assert "generated from real frames of fast take: " in out
     assert "styles fast, odd, slow" in out
     assert "transition fast -> odd at frame 60" in out  # its first two styles
     bones = read_bvh(folder / "walk_odd_001.bvh")[0].bone_names
@@ -600,6 +613,72 @@ def test_styles_runs_on_a_users_labelled_folder(tmp_path, capsys):
         assert (output / f"{name}.png").stat().st_size > 1000
     assert Image.open(output / "styles.gif").n_frames == 60
     assert Image.open(output / "transition_fast_odd.gif").n_frames == 60
+
+
+def _wave_folder(data_home, folder, styles=("exhausted", "normal"), takes=(1, 2)):
+    """Real Bandai left-hand waves of two styles, linked into ``folder`` with
+    their labels and label names, as a user's folder of the dataset has them."""
+    source = data_home / "bandai_dataset2"
+    folder.mkdir()
+    for name in ("style_label.txt", "content_label.txt"):
+        (folder / name).symlink_to(source / name)
+    for style in styles:
+        for take in takes:
+            for suffix in (".bvh", ".json"):
+                name = f"dataset-2_wave-left-hand_{style}_{take:03d}{suffix}"
+                (folder / name).symlink_to(source / name)
+    return folder
+
+
+def test_real_waves_are_judged_alive_on_their_own_moving_joints(data_home):
+    """The judge of the styles command looks at the waving arm, not the legs:
+    the middle windows of real takes (the cycle) are alive, where the
+    amplitude and frequency of the hips and knees called most of them dead."""
+    corpus = load_bandai_dataset2(
+        data_home, contents="wave-left-hand", styles=["exhausted", "normal"]
+    )
+    ids, styles = corpus.sequence_ids, corpus.target[:, 1]
+    with sklearn.config_context(enable_metadata_routing=True):
+        pre = make_motion_preprocessor(corpus.skeleton)
+        Z = pre.fit_transform(corpus.data, sequence_ids=ids)
+    moving = _style_demo.moving_joint_channels(pre, Z, ids)
+    names = pre.get_feature_names_out()[moving]
+    assert len(moving) == 12
+    assert all(
+        name.split("_")[0] in ("Shoulder", "UpperArm", "LowerArm", "Hand", "Head")
+        for name in names
+    )
+    assert sum(name.endswith(("_L_ex", "_L_ey", "_L_ez")) for name in names[:6]) == 6
+    legs = bone_columns(pre.get_feature_names_out(), ["UpperLeg_L", "UpperLeg_R"])
+    alive = {}
+    for name, channels in (("moving", moving), ("legs", legs)):
+        judge = StyleJudge(legs=channels).fit(Z, styles, sequence_ids=ids)
+        verdict = judge.verdict(Z, styles, sequence_ids=ids)
+        length = np.bincount(ids)[verdict.sequence_ids]
+        cycle = (verdict.starts >= length // 4) & (
+            verdict.starts + judge.window <= 3 * length // 4
+        )
+        alive[name] = verdict.alive[cycle].mean()
+    assert alive["moving"] >= 0.65 and alive["legs"] <= 0.35, alive
+
+
+def test_styles_on_real_waves_names_the_content(data_home, tmp_path, capsys):
+    folder = _wave_folder(data_home, tmp_path / "waves")
+    output = tmp_path / "out"
+    argv = ["styles", "--folder", str(folder), "--output", str(output)]
+    argv += [*STYLES_TINY, "--order", "2", "--n-sequences", "1", "--no-figures"]
+    assert main(argv) == 0, capsys.readouterr().err
+    out = capsys.readouterr().out
+    assert f"the wave-left-hand takes in {folder}: " in out
+    assert "generated from real frames of normal wave-left-hand: " in out
+    assert "the 12 joint angles that move most in the real takes, of UpperArm_L" in out
+    assert "walk" not in out.replace(str(folder), "").replace(str(output), "")
+    assert sorted(_table_rows(out, ["exhausted", "normal"])) == ["exhausted", "normal"]
+    (real,) = [line for line in out.splitlines() if line.startswith("real takes")]
+    assert "(the judge on the middle halves of the training takes)" in real
+    assert main([*argv, "--seed-style", "elderly"]) == 1
+    err = capsys.readouterr().err
+    assert "--seed-style: the wave-left-hands have no style 'elderly'" in err
 
 
 # -- speed as context (issue 36) ----------------------------------------------
@@ -714,6 +793,61 @@ def test_sample_says_once_that_a_sequence_came_to_rest(walker_model, tmp_path, c
     assert err == ""  # no warning saying it again
     assert "--seed-file PATH --seed-frame N" in out
     assert "history=" not in out
+
+
+def test_fit_saves_the_sampler_parameters_and_sample_overrides_them(
+    walker_model, tmp_path, capsys, monkeypatch
+):
+    """n_mean_field and hidden_drift, which only sample reads, from the
+    command line (issue 46): fit saves them in the model, sample passes
+    its own to the pipeline's sample for this run only."""
+    _, folder = walker_model
+    model = tmp_path / "m.joblib"
+    argv = ["fit", str(folder), *TINY, "--output", str(model)]
+    assert main([*argv, "--n-mean-field", "2", "--hidden-drift", "0.05"]) == 0
+    crbm = _cli._load_model(model).pipeline[-1]
+    assert (crbm.n_mean_field, crbm.hidden_drift) == (2, 0.05)
+    asked = []
+    original = _cli.MotionPipeline.sample
+
+    def spy(self, n_frames, **params):
+        asked.append(
+            {k: params[k] for k in ("n_mean_field", "hidden_drift") if k in params}
+        )
+        return original(self, n_frames, **params)
+
+    monkeypatch.setattr(_cli.MotionPipeline, "sample", spy)
+    take = folder / "walk_fast_001.bvh"  # one seed for both sequences
+    argv = ["sample", str(model), "--n-frames", "40", "--n-sequences", "2"]
+    argv += ["--seed-file", str(take), "--output", str(tmp_path / "out")]
+    drawn = {}
+    for name, extra in [
+        ("saved", []),
+        ("copies", ["--n-mean-field", "30", "--hidden-drift", "0"]),
+        ("apart", ["--n-mean-field", "1", "--hidden-drift", "2"]),
+    ]:
+        assert main([*argv, *extra]) == 0, capsys.readouterr().err
+        drawn[name] = [
+            read_bvh(tmp_path / "out" / f"generated_{k}.bvh")[1] for k in (0, 1)
+        ]
+    assert asked == [
+        {},
+        {"n_mean_field": 30, "hidden_drift": 0.0},
+        {"n_mean_field": 1, "hidden_drift": 2.0},
+    ]
+    gap = {name: np.abs(a - b).mean() for name, (a, b) in drawn.items()}
+    assert gap["copies"] < gap["apart"], gap
+
+
+def test_styles_sampler_options_reach_the_factored_model(monkeypatch, tmp_path):
+    models = []
+    monkeypatch.setattr(
+        _cli, "_run_styles", lambda args, walks, model: models.append(model) or 0
+    )
+    folder = _walker_folder(tmp_path / "mine", 30.0, n_frames=30)
+    argv = ["styles", "--folder", str(folder), "--n-mean-field", "3"]
+    assert main([*argv, "--hidden-drift", "0.2"]) == 0
+    assert (models[0].n_mean_field, models[0].hidden_drift) == (3, 0.2)
 
 
 def test_sample_seeds_from_a_take_of_ones_own(walker_model, tmp_path, capsys):

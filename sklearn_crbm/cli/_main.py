@@ -11,6 +11,7 @@ import re
 import shutil
 import sys
 import warnings
+from pathlib import Path
 
 import joblib
 import numpy as np
@@ -18,6 +19,7 @@ import sklearn
 from sklearn.utils import Bunch
 
 from ..datasets import (
+    fetch_bandai_dataset2,
     fetch_bandai_walks,
     fetch_cmu35,
     fetch_mit_walk,
@@ -28,6 +30,7 @@ from ..datasets import (
     read_bvh_folder,
     resample_frames,
 )
+from ..datasets._labels import file_labels
 from ..exceptions import GenerationWarning
 from ..metrics._liveliness import (
     DEAD_FRACTION,
@@ -36,9 +39,16 @@ from ..metrics._liveliness import (
 )
 from ..models._crbm import ConditionalRBM
 from ..models._factored import FactoredCRBM
+from ..models._labelled import LabelledCRBM
 from ..preprocessing import MotionContext, MotionPipeline, make_motion_pipeline
 from ._demo import liveliness_text, save_gif
 from ._demo import run_demo as _run_demo
+from ._labels import (
+    label_keys,
+    label_request,
+    label_text,
+    seed_windows_for,
+)
 from ._options import COMMANDS, MAX_DEFAULT_RATE
 from ._seed_file import seed_from_file
 from ._style_demo import run_styles as _run_styles
@@ -103,15 +113,19 @@ class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
         return super()._get_help_string(action)
 
 
-def _model_from_args(args):
-    """The ConditionalRBM that ``demo`` and ``fit`` train, from the model options."""
-    return ConditionalRBM(
+def _model_from_args(args, labelled=False):
+    """The ConditionalRBM that ``demo`` and ``fit`` train, from the model
+    options; a LabelledCRBM of the same options for ``fit --labels`` with
+    several keys."""
+    return (LabelledCRBM if labelled else ConditionalRBM)(
         args.n_components,
         order=args.order,
         n_iter=args.n_iter,
         history_noise=args.history_noise,
         history_noise_fraction=args.history_noise_fraction,
         average_fraction=args.average_fraction,
+        n_mean_field=args.n_mean_field,
+        hidden_drift=args.hidden_drift,
         random_state=args.seed,
         verbose=max(1, (1000 if args.n_iter == "auto" else args.n_iter) // 10),
     )
@@ -149,6 +163,7 @@ def run_fetch(args):
         "cmu35": fetch_cmu35,
         "mit": fetch_mit_walk,
         "bandai": fetch_bandai_walks,
+        "bandai-dataset2": fetch_bandai_dataset2,
     }
     print(f"downloading into {home}")
     try:
@@ -164,17 +179,28 @@ def run_fetch(args):
 
 def run_fit(args):
     data, styles = _training_data(args)
+    several = styles is not None and styles.ndim == 2
     n = len(data.sequence_names)
     print(
         f"training on {len(data.data)} frames of {n} sequence{'s' * (n != 1)} "
         f"at {data.frame_rate:g} frames/s"
-        + (f", labels {', '.join(dict.fromkeys(styles))}" if args.labels else "")
+        + (f", labels {_labels_summary(data, styles)}" if args.labels else "")
     )
+    if several and args.speed_context:
+        raise ValueError(
+            "--speed-context trains with speed as the model's context, several "
+            "--labels with the labels: give one of the two."
+        )
     _check_order(args.order, data)
-    pipeline = make_motion_pipeline(data.skeleton, _model_from_args(args))
+    pipeline = make_motion_pipeline(
+        data.skeleton, _model_from_args(args, labelled=several)
+    )
     speed = _speed_context(data, styles) if args.speed_context else {}
     context = {"context": speed.pop("speeds")} if speed else {}
-    pipeline.fit(data.data, sequence_ids=data.sequence_ids, **context)
+    if several:  # one model of every label: a factor per key
+        pipeline.fit(data.data, styles, sequence_ids=data.sequence_ids)
+    else:
+        pipeline.fit(data.data, sequence_ids=data.sequence_ids, **context)
     windows = {}
     if styles is not None:
         windows = pipeline.style_windows(
@@ -184,12 +210,31 @@ def run_fit(args):
             n_windows=N_STYLE_WINDOWS,
             random_state=args.seed,
         )
+    keys = {"label_keys": data.label_keys} if several else {}
     saved = Bunch(
-        pipeline=pipeline, seed_windows=windows, frame_rate=data.frame_rate, **speed
+        pipeline=pipeline,
+        seed_windows=windows,
+        frame_rate=data.frame_rate,
+        **keys,
+        **speed,
     )
     joblib.dump(dict(saved), args.output)
     print(f"saved the fitted pipeline to {args.output}")
     return 0
+
+
+def _labels_summary(data, labels):
+    """``"fast, slow"``, or for several keys ``"content: run, walk; style:
+    elderly, normal (3 of their 4 combinations)"``."""
+    if labels.ndim == 1:
+        return ", ".join(dict.fromkeys(labels))
+    names = [
+        f"{key}: {', '.join(map(str, known))}"
+        for key, known in zip(data.label_keys, data.target_names, strict=True)
+    ]
+    seen = len({tuple(row) for row in labels.tolist()})
+    possible = int(np.prod([len(known) for known in data.target_names]))
+    return f"{'; '.join(names)} ({seen} of their {possible} combinations)"
 
 
 def _speed_context(data, styles):
@@ -228,6 +273,8 @@ def _training_data(args):
     data = _read_motion_folder(args.folder, args.frame_rate, args.labels)
     if args.labels is None:
         return data, None
+    if "label_keys" in data:  # several: the names themselves
+        return data, data.target
     return data, data.target_names[data.target]
 
 
@@ -237,7 +284,9 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
     ``frame_rate`` None: the files' own rate, brought down to
     ``MAX_DEFAULT_RATE`` when faster.  ``labels``: see ``fit --labels``; the
     label names are text, as typed after ``--style`` (also labels that are
-    numbers).
+    numbers).  With several keys, ``target`` holds every frame's names,
+    one column per key, ``target_names`` the names of each key and
+    ``label_keys`` the keys.
     """
     if not folder.is_dir():
         raise FileNotFoundError(f"{folder} is not a folder.")
@@ -250,7 +299,9 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
             f"{folder} holds no *.bvh or *.amc file: the command reads a folder "
             "of BVH files, or of AMC files with their ASF skeleton."
         )
-    labels = _label_source(labels)
+    keys = label_keys(labels)
+    several = keys is not None and len(keys) > 1
+    labels = keys if several else _label_source(labels)
     try:
         data = read(folder, frame_rate=frame_rate, labels=labels)
     except ValueError as exc:
@@ -263,6 +314,10 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
             "sets the rate to train at: at most the slowest file's (leave it out to "
             "train at the files' own rate)."
         ) from None
+    if several:
+        data.target_names = [names.astype(str) for names in data.target_names]
+        data.label_keys = keys
+        _check_label_names(data)
     if frame_rate is None and data.frame_rate > MAX_DEFAULT_RATE:
         keep = resample_frames(
             np.arange(len(data.data)),
@@ -274,9 +329,21 @@ def _read_motion_folder(folder, frame_rate=None, labels=None):
             if key in data:
                 data[key] = data[key][keep]
         data.frame_rate = MAX_DEFAULT_RATE
-    if labels is not None:
+    if labels is not None and not several:
         data.target_names = np.array([str(name) for name in data.target_names])
     return data
+
+
+def _check_label_names(data):
+    """Names that ``sample --label`` can give back: no comma in any."""
+    for key, names in zip(data.label_keys, data.target_names, strict=True):
+        odd = [str(name) for name in names if "," in name]
+        if odd:
+            raise ValueError(
+                f"the {key} label {odd[0]!r} holds a comma, which separates the "
+                "labels of 'sample --label'; rename the labels in the label "
+                "files."
+            )
 
 
 def _label_source(labels):
@@ -334,7 +401,8 @@ def _load_model(path):
 def run_sample(args):
     saved = _load_model(args.model)
     pipeline = saved.pipeline
-    history, seeded = _seeds(saved, args)
+    request = _label_request(saved, args)
+    history, seeded = _seeds(saved, args, request)
     with warnings.catch_warnings():
         # every sequence's verdict is printed beside its file, once
         warnings.simplefilter("ignore", GenerationWarning)
@@ -344,6 +412,8 @@ def run_sample(args):
             n_sequences=args.n_sequences,
             hidden_noise=args.hidden_noise,
             random_state=args.seed,
+            **({} if request is None else {"y": request}),
+            **_sampler_request(args),
             **_speed_request(saved, args),
         )
     suffixes = [".bvh"] + [".amc"] * (pipeline.skeleton.convention == "acclaim")
@@ -374,6 +444,46 @@ def run_sample(args):
         )
         print(f"wrote {path.name}")
     return 0
+
+
+def _label_request(saved, args):
+    """``sample --label``: one label per key of a model fitted on several
+    (``fit --labels content,style``), checked; None for any other model."""
+    keys = saved.get("label_keys")
+    if keys is None:
+        if args.label is not None:
+            raise ValueError(
+                f"--label asks for labels of a model fitted on several (fit "
+                f"--labels content,style); {args.model} was not: seed it with "
+                "real frames of a label with --style."
+            )
+        return None
+    if args.style is not None:
+        raise ValueError(
+            f"{args.model} was fitted on the labels {', '.join(keys)}: ask for "
+            f"them with --label (such as --label {_a_label(saved)}), "
+            "not --style."
+        )
+    if args.label is None:
+        raise ValueError(
+            f"{args.model} was fitted on the labels {', '.join(keys)}: say which "
+            f"to generate with --label, one of each (such as --label "
+            f"{_a_label(saved)})."
+        )
+    return label_request(args.label, keys, saved.pipeline[-1].classes_)
+
+
+def _a_label(saved):
+    """The labels of the first seed windows a model of several labels keeps,
+    as ``sample --label`` takes them."""
+    return label_text(next(iter(saved.seed_windows)))
+
+
+def _sampler_request(args):
+    """``sample``'s ``--n-mean-field`` and ``--hidden-drift`` where given
+    (left out, the saved model's own parameters)."""
+    asked = dict(n_mean_field=args.n_mean_field, hidden_drift=args.hidden_drift)
+    return {name: value for name, value in asked.items() if value is not None}
 
 
 def _speed_request(saved, args):
@@ -428,9 +538,11 @@ def _verdicts(pipeline, raw, n_frames):
     return verdicts, failed
 
 
-def _seeds(saved, args):
+def _seeds(saved, args, request=None):
     """``sample``'s history and what it is: saved windows of the chosen
-    style, frames of ``--seed-file``, or None (the model's own windows)."""
+    style or labels (``request``), frames of ``--seed-file``, or None (the
+    model's own windows)."""
+    asked = "" if request is None else f"{label_text(request)}, "
     if args.seed_frame is not None and args.seed_file is None:
         raise ValueError("--seed-frame N picks a frame of --seed-file PATH: give both.")
     if args.seed_file is not None:
@@ -442,7 +554,14 @@ def _seeds(saved, args):
             saved.pipeline, saved.frame_rate, args.seed_file, args.seed_frame
         )
         history = np.repeat(seed.window[None], args.n_sequences, axis=0)
-        return history, f"seeded with {seed.text}"
+        return history, f"{asked}seeded with {seed.text}"
+    rng = np.random.default_rng(args.seed)
+    if request is not None:
+        windows, name = seed_windows_for(saved.seed_windows, request)
+        if windows is None:
+            return None, f"{asked}seeded with training frames"
+        chosen = windows[rng.integers(len(windows), size=args.n_sequences)]
+        return chosen, f"{asked}seeded with {name} frames"
     if args.style is None:
         return None, "seeded with training frames"
     if args.style not in saved.seed_windows:
@@ -453,15 +572,23 @@ def _seeds(saved, args):
             "sequence, or seed from a take of your own with --seed-file."
         )
     windows = saved.seed_windows[args.style]
-    rng = np.random.default_rng(args.seed)
     chosen = windows[rng.integers(len(windows), size=args.n_sequences)]
     return chosen, f"seeded with {args.style} frames"
 
 
 def run_styles(args):
+    keys = label_keys(args.labels)
+    if args.folder is not None and len(keys) > 1:
+        raise ValueError(
+            f"--labels {args.labels}: the styles command models one label (a "
+            "style); to model several, train with 'fit FOLDER --labels "
+            f"{args.labels}' and generate with 'sample MODEL --label ...'."
+        )
     if args.folder is not None:
         walks = _read_motion_folder(args.folder, args.frame_rate, args.labels)
-        walks.name = f"the motion in {args.folder}"
+        walks.noun = _content_noun(args.folder, walks)
+        kind = "" if walks.noun == "take" else f"{walks.noun} "
+        walks.name = f"the {kind}takes in {args.folder}"
     else:
         walks = _load(
             load_bandai_walks,
@@ -470,6 +597,7 @@ def run_styles(args):
             " --dataset bandai",
         )
         walks.name = "Bandai Namco walks"
+        walks.noun = "walk"
     model = FactoredCRBM(
         args.n_components,
         n_factors=args.n_factors,
@@ -477,11 +605,25 @@ def run_styles(args):
         order=args.order,
         n_iter=args.n_iter,
         n_gibbs=args.n_gibbs,
+        n_mean_field=args.n_mean_field,
+        hidden_drift=args.hidden_drift,
         random_state=args.seed,
         verbose=max(1, args.n_iter // 10),
     )
     _check_order(args.order, walks)
     return _run_styles(args, walks, model)
+
+
+def _content_noun(folder, data):
+    """What the takes of a folder are: the one content of their JSON labels
+    (``"wave-left-hand"``, as the Bandai Namco files name it), else "take"."""
+    paths = [Path(name) for name in data.filenames]
+    try:
+        codes, names = file_labels(folder, paths, "content")
+    except (OSError, ValueError, TypeError):  # no content labels
+        return "take"
+    contents = set(names[codes].tolist())
+    return contents.pop() if len(contents) == 1 else "take"
 
 
 _RUNS = {

@@ -60,6 +60,31 @@ def _count(minimum):
 _rate = _checked(
     float, "a number of frames per second", lambda r: 0 < r < math.inf, "positive"
 )
+_non_negative = _checked(float, "a number", lambda x: 0 <= x < math.inf, "at least 0")
+
+
+def _sampler_options(defaults, what):
+    """``--n-mean-field`` and ``--hidden-drift``: parameters that only
+    sampling reads, with ``defaults``' values (None: the saved model's)."""
+    default = "the saved model's own" if defaults is None else None
+    return [
+        _option(
+            "--n-mean-field",
+            type=_count(1),
+            default=None if defaults is None else defaults.n_mean_field,
+            help=f"mean-field steps that end every generated frame{what}: more "
+            "is smoother, fewer lets the sequences drawn from one seed differ"
+            + (f" (default: {default})" if default else ""),
+        ),
+        _option(
+            "--hidden-drift",
+            type=_non_negative,
+            default=None if defaults is None else defaults.hidden_drift,
+            help="standard deviation of a smooth random offset of the hidden "
+            f"biases that keeps the sequences drawn from one seed apart{what}; "
+            "0: none" + (f" (default: {default})" if default else ""),
+        ),
+    ]
 
 
 def _speed_request(text):
@@ -156,6 +181,7 @@ _MODEL_OPTIONS = [
         help="training epochs (the paper: 4000); auto: enough for 25,000 "
         "minibatch updates, at least 1000",
     ),
+    *_sampler_options(_DEFAULTS, ", saved with the model"),
     _SEED,
 ]
 _FACTORED_OPTIONS = [
@@ -195,6 +221,7 @@ _FACTORED_OPTIONS = [
         default=_FACTORED.n_gibbs,
         help="Gibbs iterations per generated frame",
     ),
+    *_sampler_options(_FACTORED, ""),
     _SEED,
 ]
 
@@ -249,11 +276,14 @@ COMMANDS = {
             _option(
                 "--dataset",
                 action="append",
-                choices=["cmu35", "mit", "bandai"],
+                choices=["cmu35", "mit", "bandai", "bandai-dataset2"],
                 help="download this data set (repeat for several): cmu35, "
-                "mit (Taylor's MIT walking data) or bandai (the Bandai Namco "
+                "mit (Taylor's MIT walking data), bandai (the Bandai Namco "
                 "walks in seven styles, 15 MB, CC BY-NC 4.0, for the styles "
-                "command); default: cmu35 and mit",
+                "command) or bandai-dataset2 (the Bandai Namco corpus of ten "
+                "contents in seven styles, takes 001-012, 840 takes with "
+                "content and style labels, 174 MB, CC BY-NC 4.0, for 'fit "
+                "--labels content,style'); default: cmu35 and mit",
             ),
         ],
     ),
@@ -285,7 +315,10 @@ COMMANDS = {
                 "file ('style' reads walk_001.json's {\"style\": 2}, named by "
                 "style_label.txt when there is one), or a regular expression "
                 "with a group, matched against each file's name "
-                "('walk_([a-z]+)_' labels walk_proud_01.bvh 'proud')",
+                "('walk_([a-z]+)_' labels walk_proud_01.bvh 'proud'); several "
+                "keys separated by commas ('content,style') train one "
+                "LabelledCRBM of all of them, one label factor per key, that "
+                "'sample --label run,elderly' asks for any combination",
             ),
             _option(
                 "--speed-context",
@@ -316,6 +349,15 @@ COMMANDS = {
                 help="seed each sequence with real frames of this style ('walk' "
                 "or 'jog' for CMU 35); default: the model's own seed windows, "
                 "from every training sequence",
+            ),
+            _option(
+                "--label",
+                metavar="LABEL,LABEL",
+                help="for a model fitted on several labels ('fit --labels "
+                "content,style'): the labels of the generated motion, one per "
+                "key in their order, such as run,elderly; any combination, "
+                "also one the training takes lack (seeded then with frames "
+                "of the nearest labels)",
             ),
             _option(
                 "--seed-file",
@@ -353,6 +395,7 @@ COMMANDS = {
                 "at every frame: 0 follows the model's own dynamics, more noise "
                 "lets the motion switch styles (paper §4.3)",
             ),
+            *_sampler_options(None, ""),
             _option(
                 "--seed",
                 type=int,
@@ -377,18 +420,20 @@ COMMANDS = {
         "many styles from one factored CRBM: BVH files, strips, a judge",
         "Train a FactoredCRBM (Taylor & Hinton, ICML 2009) on the Bandai "
         "Namco walks in seven styles (or on a labelled folder of your own, "
-        "--folder and --labels), generate a walk in every style, a "
+        "--folder and --labels), generate every style, a "
         "50/50 blend of two styles and a transition from one style to "
-        "another half-way, all seeded with real frames of a normal walk, "
+        "another half-way, all seeded with real frames of one style, "
         "and write them as BVH files with a skeleton strip of each, a "
         "plot of the style judge's probabilities over the transition, and "
         "GIFs of every style moving side by side and of the transition over "
         "the judge's probabilities. "
         "Prints a table of how a StyleJudge trained on the real takes sees "
         "every style: the share of 2-s windows judged as the style asked "
-        "for, and the leg amplitude and step frequency against the real "
-        "takes. The defaults train for several minutes; fetch the data "
-        "first with 'fetch --dataset bandai'.",
+        "for, and the amplitude and frequency of the joints that move most "
+        "in the real takes (the legs of a walk, the arm of a wave) against "
+        "theirs, beside the judge's verdict on the real takes. The defaults "
+        "train for several minutes; fetch the data first with 'fetch "
+        "--dataset bandai'.",
         [
             _DATA_HOME,
             _option(

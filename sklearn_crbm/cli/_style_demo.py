@@ -1,11 +1,13 @@
 """The command line's styles command: many styles from one factored CRBM.
 
-Train a :class:`~sklearn_crbm.FactoredCRBM` on the Bandai Namco walks,
-generate every style, a blend and a transition from real frames of one style,
-write them as BVH files and figures, and print how a
-:class:`~sklearn_crbm.metrics.StyleJudge` trained on the real takes sees
-them.  The library does the work (:class:`~sklearn_crbm.preprocessing.
-MotionPipeline` trains, generates and writes, the judge judges, the plotting
+Train a :class:`~sklearn_crbm.FactoredCRBM` on the Bandai Namco walks (or
+a labelled folder of the user's), generate every style, a blend and a
+transition from real frames of one style, write them as BVH files and
+figures, and print how a :class:`~sklearn_crbm.metrics.StyleJudge` trained
+on the real takes sees them, its liveliness judged on the joints that move
+most in the real takes (the legs of a walk, the arm of a wave).  The
+library does the work (:class:`~sklearn_crbm.preprocessing.MotionPipeline`
+trains, generates and writes, the judge judges, the plotting
 functions draw); this module chooses what to generate and prints.
 """
 
@@ -14,8 +16,7 @@ import time
 import numpy as np
 import sklearn
 
-from ..datasets import bone_columns
-from ..metrics import StyleJudge
+from ..metrics import StyleJudge, most_moving_channels
 from ..metrics._style import _nanmedian
 from ..plotting import plot_motion_strip, plot_style_probabilities
 from ..plotting._base import check_matplotlib
@@ -24,9 +25,11 @@ from ._demo import GIF_FRAMES, GIF_STEP, _save, save_gif
 
 __all__ = ["run_styles", "style_requests"]
 
-# The hips and knees of the Bandai skeleton: their amplitude and frequency
-# tell a walk from a pose.
-LEGS = ("UpperLeg_L", "UpperLeg_R", "LowerLeg_L", "LowerLeg_R")
+# The judge's liveliness: the amplitude and frequency of the joint angles
+# that move most within the real takes, ranked in radians (as the
+# benchmarks judge generated motion): the legs of a walk, the arm of a wave.
+N_MOVING = 12
+ANGLE_SUFFIXES = ("_ex", "_ey", "_ez")
 # Judged windows start here or later: the first frames still move like the
 # seed's style.
 JUDGED_FROM = 100
@@ -79,7 +82,7 @@ def default_styles(args, styles):
         setattr(args, option, wanted[0] if isinstance(default, str) else wanted)
 
 
-def check_style_arguments(args, styles):
+def check_style_arguments(args, styles, noun="take"):
     """Fail before training when an option names a style the data lack."""
     if len(styles) < 2:
         raise ValueError(
@@ -95,7 +98,7 @@ def check_style_arguments(args, styles):
         for name in names:
             if name not in styles:
                 raise ValueError(
-                    f"{option}: the walks have no style {name!r}; their styles "
+                    f"{option}: the {noun}s have no style {name!r}; their styles "
                     f"are {', '.join(map(str, styles))}."
                 )
     if args.blend[0] == args.blend[1] or args.transition[0] == args.transition[1]:
@@ -111,11 +114,15 @@ def check_style_arguments(args, styles):
 
 
 def run_styles(args, walks, model):
-    """Train ``model`` on ``walks``, generate, judge, print and write files."""
+    """Train ``model`` on ``walks``, generate, judge, print and write files.
+
+    ``walks.name`` says what the takes are and where they come from,
+    ``walks.noun`` what one take is ("walk", "wave-left-hand", "take").
+    """
     start = time.perf_counter()
     labels = walks.target_names[walks.target]
     styles = sorted(set(labels.tolist()))  # the model's classes_
-    check_style_arguments(args, styles)
+    check_style_arguments(args, styles, walks.noun)
     print(
         f"{walks.name}: {len(walks.data)} frames in "
         f"{len(walks.sequence_names)} takes at {walks.frame_rate:g} frames/s, "
@@ -127,12 +134,13 @@ def run_styles(args, walks, model):
         pipeline = make_motion_pipeline(walks.skeleton, model)
         pipeline.fit(walks.data, labels, sequence_ids=walks.sequence_ids)
         generated = _generate(pipeline, walks, labels, args)
-        judge = _fit_judge(pipeline, walks, labels)
+        judge, real = _fit_judge(pipeline, walks, labels)
         judged = {
             name: (pipeline[:-1].transform(raw, sequence_ids=ids), ids)
             for name, (raw, ids) in generated.items()
         }
-    _print_table(judge, judged, walks.frame_rate, args)
+    joints = _joint_names(pipeline, judge.legs)
+    _print_table(judge, judged, walks.frame_rate, args, walks.noun, joints, real)
     args.output.mkdir(parents=True, exist_ok=True)
     written = _write_motion(pipeline, generated, walks.frame_rate, args.output)
     if not args.no_figures:
@@ -172,31 +180,71 @@ def _generate(pipeline, walks, labels, args):
 
 
 def _fit_judge(pipeline, walks, labels):
-    """A StyleJudge of 2-s windows, trained on every real take."""
-    Z = pipeline[:-1].transform(walks.data, sequence_ids=walks.sequence_ids)
-    names = pipeline[:-1].get_feature_names_out()
-    has_legs = any(name.startswith(f"{bone}_") for name in names for bone in LEGS)
-    legs = bone_columns(names, LEGS, strict=False) if has_legs else None
-    return StyleJudge(legs=legs).fit(Z, labels, sequence_ids=walks.sequence_ids)
+    """A StyleJudge of 2-s windows, trained on every real take, whose
+    liveliness is that of the joints that move most in them, and its verdict
+    on the real takes."""
+    ids = walks.sequence_ids
+    Z = pipeline[:-1].transform(walks.data, sequence_ids=ids)
+    moving = moving_joint_channels(pipeline[:-1], Z, ids)
+    judge = StyleJudge(legs=moving).fit(Z, labels, sequence_ids=ids)
+    verdict = judge.verdict(Z, labels, sequence_ids=ids)
+    # the middle halves of the takes: their cycle, which generation continues
+    length = np.bincount(ids)[verdict.sequence_ids]
+    cycle = (verdict.starts >= length // 4) & (
+        verdict.starts + judge.window <= 3 * length // 4
+    )
+    if not cycle.any():  # takes too short for a window in their middle
+        cycle[:] = True
+    return judge, (verdict.correct[cycle].mean(), verdict.alive[cycle].mean())
 
 
-def _print_table(judge, judged, frame_rate, args):
+def moving_joint_channels(preprocessor, Z, sequence_ids, n_channels=N_MOVING):
+    """Columns of ``Z``: the joint angles that move most within the real takes.
+
+    :func:`~sklearn_crbm.metrics.most_moving_channels` of the exponential
+    maps in radians, before the preprocessor's last step (the scaler) made
+    every channel's spread alike: the legs of a walk, the arm of a wave.
+    Every channel of ``Z`` when it has no joint angles.
+    """
+    names = preprocessor.get_feature_names_out()
+    angles = [j for j, name in enumerate(names) if name.endswith(ANGLE_SUFFIXES)]
+    scaler = preprocessor[-1]
+    unscaled = scaler.inverse_transform(Z)
+    if unscaled.shape[1] != Z.shape[1]:  # the scaler put back constant channels
+        unscaled = unscaled[:, ~scaler.constant_mask_]
+    return most_moving_channels(
+        unscaled,
+        sequence_ids=sequence_ids,
+        n_channels=n_channels,
+        features=angles or None,
+    )
+
+
+def _joint_names(pipeline, columns):
+    """The joints of the channels ``columns``, most moving first, once each."""
+    names = pipeline[:-1].get_feature_names_out()[columns]
+    return list(dict.fromkeys(name.rsplit("_", 1)[0] for name in names))
+
+
+def _print_table(judge, judged, frame_rate, args, noun, joints, real_takes):
     first = min(JUDGED_FROM, args.n_frames - judge.window)
     print(
-        f"\ngenerated from real frames of a {args.seed_style} walk: "
+        f"\ngenerated from real frames of {args.seed_style} {noun}: "
         f"{args.n_sequences} sequence{'s' * (args.n_sequences != 1)} of "
         f"{args.n_frames} frames per style, their {judge.window}-frame windows "
         f"from frame {first} on judged by a StyleJudge trained on the real takes\n"
+        f"  moving       the {len(judge.legs)} joint angles that move most in the "
+        f"real takes, of {', '.join(joints)}\n"
         "  judged       share of windows judged as the style asked for\n"
-        "  alive        share of windows whose leg amplitude and step frequency "
-        f"are within {judge.amplitude_tolerance:.0%} and "
+        "  alive        share of windows whose moving joints' amplitude and "
+        f"cycle frequency are within {judge.amplitude_tolerance:.0%} and "
         f"{judge.frequency_tolerance:.0%} of the style's real windows\n"
-        "  amplitude    leg amplitude (hips and knees) over that of the "
-        "style's median real window\n"
-        "  steps/s      step frequency (cycles of one leg per second), "
-        "generated (real); - for legs that do not move"
+        "  amplitude    the moving joints' amplitude over that of the style's "
+        "median real window\n"
+        "  cycles/s     their dominant frequency (the steps of one leg, the "
+        "swings of an arm), generated (real); - for joints that do not move"
     )
-    print(f"{'style':<12}{'judged':>7}{'alive':>7}{'amplitude':>11}   steps/s")
+    print(f"{'style':<12}{'judged':>7}{'alive':>7}{'amplitude':>11}   cycles/s")
     for k, style in enumerate(judge.classes_):
         Z, ids = judged[style]
         verdict = judge.verdict(Z, style, sequence_ids=ids)
@@ -210,8 +258,19 @@ def _print_table(judge, judged, frame_rate, args):
             f"{np.median(verdict.amplitude_ratio[kept]):11.2f}   "
             f"{frequency} ({real:.2f})"
         )
+    _print_real(real_takes)
     _print_blend(judge, judged, first, args)
     _print_transition(judge, judged, first, args)
+
+
+def _print_real(real):
+    """The judge on the real takes' middle halves (their cycle), beside its
+    figures for the generated motion: how far they can be trusted."""
+    judged, alive = real
+    print(
+        f"{'real takes':<12}{judged:7.0%}{alive:7.0%}   (the judge on the "
+        "middle halves of the training takes)"
+    )
 
 
 def _print_blend(judge, judged, first, args):

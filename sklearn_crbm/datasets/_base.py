@@ -7,14 +7,26 @@ import numpy as np
 from sklearn.utils import Bunch
 
 from ..utils._sequences import remember_sequences, stack_sequences
-from ._bandai import BANDAI_FOLDER
-from ._folders import read_bvh_folder
+from ._bandai import (
+    BANDAI_FOLDER,
+    DATASET2_FOLDER,
+    dataset2_filenames,
+    dataset2_selection,
+)
+from ._bvh import read_bvh
+from ._folders import _long_format, _with_labels, read_bvh_folder
 from ._frame_rate import kept_frames
 from ._mit import load_mit_mat
 from ._parsing import load_mat_variables
 from ._skeleton import Skeleton
 
-__all__ = ["get_data_home", "load_bandai_walks", "load_cmu35", "load_mit_walk"]
+__all__ = [
+    "get_data_home",
+    "load_bandai_dataset2",
+    "load_bandai_walks",
+    "load_cmu35",
+    "load_mit_walk",
+]
 
 DATA_HOME_ENV = "SKLEARN_CRBM_DATA"
 FRAME_RATE = 30.0
@@ -325,6 +337,141 @@ def load_bandai_walks(data_home=None):
     return walks
 
 
+# The label keys of the JSON file beside every take of dataset-2: the
+# columns of load_bandai_dataset2's target.
+DATASET2_LABELS = ("content", "style")
+
+
+def load_bandai_dataset2(data_home=None, *, contents=None, styles=None, takes=None):
+    """Bandai Namco dataset-2: ten contents in seven styles, both labels per frame.
+
+    The second set of the Bandai Namco Research Motion dataset (Kobayashi et
+    al., 2023): one actor performing ten contents (``walk``,
+    ``walk-turn-left``, ``walk-turn-right``, ``run``, ``wave-both-hands``,
+    ``wave-left-hand``, ``wave-right-hand``, ``raise-up-both-hands``,
+    ``raise-up-left-hand``, ``raise-up-right-hand``) in each of seven styles
+    (``active``, ``elderly``, ``exhausted``, ``feminine``, ``masculine``,
+    ``normal``, ``youthful``), takes 001-012 of every content and style:
+    840 takes, 132,297 frames at 30 frames per second, or the cells and
+    takes asked for.  Each take's content and style come from its JSON file,
+    named by ``content_label.txt`` and ``style_label.txt``.  The skeleton is
+    that of :func:`load_bandai_walks` (whose takes are among these).
+
+    The walks, turns and runs are cyclic locomotion; the waves are cyclic
+    upper-body motion (each take raises the arms first and lowers them
+    last); the raises are one action, then rest.
+
+    Needs the folder ``bandai_dataset2/`` in ``data_home`` with the files
+    asked for (see :func:`fetch_bandai_dataset2`, which takes the same
+    ``contents``, ``styles`` and ``takes``).
+
+    Parameters
+    ----------
+    data_home : path-like, default=None
+        See :func:`get_data_home`.
+    contents : str or list of str, default=None
+        The contents to load, such as ``"run"`` or ``["walk", "run"]``;
+        ``None`` means all ten.
+    styles : str or list of str, default=None
+        The styles to load; ``None`` means all seven.
+    takes : int or list of int, default=None
+        The take numbers to load, from 1 to 12; ``None`` means all twelve.
+
+    Returns
+    -------
+    data : :class:`~sklearn.utils.Bunch`
+        data : ndarray of shape (n_frames, 132)
+            Raw BVH channels of the takes, in sorted order of their names.
+        sequence_ids : ndarray of shape (n_frames,)
+            Index into ``sequence_names`` of every frame.
+        sequence_names : ndarray of str
+            Take names such as ``"dataset-2_run_elderly_001"``.
+        takes : ndarray of shape (n_sequences,)
+            The take number of every sequence (1 to 12).
+        target : ndarray of str of shape (n_frames, 2)
+            The content and style of every frame, such as ``["run",
+            "elderly"]``: the ``y`` of a model of several label factors.
+        target_columns : tuple of str
+            ``("content", "style")``, the columns of ``target``.
+        target_names : list of two ndarrays of str
+            The contents and the styles loaded, in the dataset's order.
+        feature_names, skeleton, skeletons, frame_rate, filenames
+            As :func:`read_bvh_folder` gives them.
+        DESCR : str
+            Description, licence and citation.
+
+    Raises
+    ------
+    ValueError
+        If a content, style or take is not one of the corpus's.
+    FileNotFoundError
+        If a take asked for is not in ``data_home``; the message tells how
+        to fetch it.
+
+    See Also
+    --------
+    load_bandai_walks : The walks alone, takes 001-006, with one label.
+
+    Examples
+    --------
+    >>> from sklearn_crbm.datasets import load_bandai_dataset2
+    >>> corpus = load_bandai_dataset2(
+    ...     contents=["walk", "run"], styles="elderly", takes=[1, 2]
+    ... )  # doctest: +SKIP
+    >>> corpus.sequence_names.tolist()  # doctest: +SKIP
+    ['dataset-2_run_elderly_001', 'dataset-2_run_elderly_002', \
+'dataset-2_walk_elderly_001', 'dataset-2_walk_elderly_002']
+    >>> corpus.target[0].tolist()  # doctest: +SKIP
+    ['run', 'elderly']
+    """
+    selection = dataset2_selection(contents, styles, takes)
+    folder = get_data_home(data_home) / DATASET2_FOLDER
+    paths = [folder / name for name in dataset2_filenames(*selection)]
+    _check_dataset2_files(folder, paths, selection)
+    sequences = []
+    for path in paths:
+        skeleton, data, _, rate = read_bvh(path)
+        sequences.append((path, skeleton, data, rate))
+    corpus = _long_format(folder, sequences, FRAME_RATE, "BVH")
+    corpus = _with_labels(corpus, folder, paths, list(DATASET2_LABELS), None)
+    corpus.update(
+        target_columns=DATASET2_LABELS,
+        takes=np.array([int(name[-3:]) for name in corpus.sequence_names]),
+        DESCR=DATASET2_DESCR,
+    )
+    return corpus
+
+
+def _check_dataset2_files(folder, paths, selection):
+    """A FileNotFoundError saying how to fetch the takes asked for, if missing."""
+    missing = [
+        path
+        for path in paths
+        if not (path.is_file() and path.with_suffix(".json").is_file())
+    ]
+    missing += [
+        folder / f"{key}_label.txt"
+        for key in DATASET2_LABELS
+        if not (folder / f"{key}_label.txt").is_file()
+    ]
+    if not missing:
+        return
+    contents, styles, takes = selection
+    asked = ", ".join(
+        f"{key}={list(value)!r}"
+        for key, value in zip(("contents", "styles", "takes"), selection, strict=True)
+        if len(value) < {"contents": 10, "styles": 7, "takes": 12}[key]
+    )
+    raise FileNotFoundError(
+        f"{len(missing)} file{'s' * (len(missing) != 1)} of the takes asked for "
+        f"{'are' if len(missing) != 1 else 'is'} not in {folder}, such as "
+        f"{missing[0].name} (or its JSON label). Download them with "
+        f"sklearn_crbm.datasets.fetch_bandai_dataset2(data_home=...{', ' * bool(asked)}"
+        f"{asked}), or set ${DATA_HOME_ENV} to a folder that has "
+        f"{DATASET2_FOLDER}/."
+    )
+
+
 CMU35_DESCR = """\
 CMU subject 35: walking and jogging
 -----------------------------------
@@ -388,6 +535,36 @@ take from its JSON label file.
     :Frames: 11,337 in 42 takes (200 to 466 frames each), 30 per second
     :Styles: active, elderly, exhausted, feminine, masculine, normal,
         youthful (6 takes each)
+    :Channels: 132 raw BVH channels: position and rotation (ZXY Euler
+        angles in degrees) of each of 22 joints
+    :Skeleton: a static ``joint_Root`` above the moving ``Hips``; Y up,
+        centimetres
+
+Licence: Creative Commons Attribution-NonCommercial 4.0 International (the
+``LICENSE`` file). Please cite: M. Kobayashi, C.-C. Liao, K. Inoue, S.
+Yojima, M. Takahashi, "Motion Capture Dataset for Practical Use of AI-based
+Motion Editing and Stylization", arXiv:2306.08861, 2023.
+"""
+
+DATASET2_DESCR = """\
+Bandai Namco Research Motion dataset-2: ten contents in seven styles
+--------------------------------------------------------------------
+
+The second set of the Bandai Namco Research Motion dataset
+(BandaiNamcoResearchInc/Bandai-Namco-Research-Motiondataset): one actor
+performing ten contents in seven styles, takes 001-012 of every content and
+style, with the content and style of each take from its JSON label file.
+
+**Data Set Characteristics:**
+
+    :Frames: 132,297 in 840 takes, 30 per second (the takes 001-012 of all
+        70 cells; the whole dataset-2 has 2,902 takes)
+    :Contents: walk, walk-turn-left, walk-turn-right, run (cyclic
+        locomotion); wave-both-hands, wave-left-hand, wave-right-hand
+        (cyclic, upper body); raise-up-both-hands, raise-up-left-hand,
+        raise-up-right-hand (one action, then rest)
+    :Styles: active, elderly, exhausted, feminine, masculine, normal,
+        youthful
     :Channels: 132 raw BVH channels: position and rotation (ZXY Euler
         angles in degrees) of each of 22 joints
     :Skeleton: a static ``joint_Root`` above the moving ``Hips``; Y up,

@@ -12,15 +12,21 @@ from ._bandai import (
     BANDAI_FOLDER,
     BANDAI_REPOSITORY,
     BANDAI_SHA256,
+    DATASET2_FOLDER,
+    DATASET2_SHA256,
     bandai_source_path,
+    dataset2_filenames,
+    dataset2_selection,
 )
 from ._base import CMU35_FOLDER, MIT_FOLDER, get_data_home
 
 __all__ = [
+    "BANDAI_DATASET2_FILES",
     "BANDAI_WALK_FILES",
     "CMU35_FILES",
     "MIT_WALK_FILES",
     "RemoteFile",
+    "fetch_bandai_dataset2",
     "fetch_bandai_walks",
     "fetch_cmu35",
     "fetch_mit_walk",
@@ -77,17 +83,23 @@ MIT_WALK_FILES = (
                "d91828a48afe679eee20215b7657a0f54258654d3a2c9d6e943fec41dc7a0ddf"),
 )  # fmt: skip
 
-BANDAI_WALK_FILES = tuple(
-    RemoteFile(
-        BANDAI_FOLDER,
-        filename,
-        BANDAI_REPOSITORY,
-        BANDAI_COMMIT,
-        bandai_source_path(filename),
-        sha256,
+
+def _bandai_files(folder, table):
+    return tuple(
+        RemoteFile(
+            folder,
+            filename,
+            BANDAI_REPOSITORY,
+            BANDAI_COMMIT,
+            bandai_source_path(filename),
+            sha256,
+        )
+        for filename, sha256 in table.items()
     )
-    for filename, sha256 in BANDAI_SHA256.items()
-)
+
+
+BANDAI_WALK_FILES = _bandai_files(BANDAI_FOLDER, BANDAI_SHA256)
+BANDAI_DATASET2_FILES = _bandai_files(DATASET2_FOLDER, DATASET2_SHA256)
 
 
 def fetch_cmu35(data_home=None, *, base_url=None, timeout=60.0, verbose=True):
@@ -221,6 +233,81 @@ def fetch_bandai_walks(data_home=None, *, base_url=None, timeout=60.0, verbose=T
     >>> walks = load_bandai_walks(fetch_bandai_walks())  # doctest: +SKIP
     """
     return _fetch_files(BANDAI_WALK_FILES, data_home, base_url, timeout, verbose)
+
+
+def fetch_bandai_dataset2(
+    data_home=None,
+    *,
+    contents=None,
+    styles=None,
+    takes=None,
+    base_url=None,
+    timeout=60.0,
+    verbose=True,
+):
+    """Download the Bandai Namco corpus of :func:`load_bandai_dataset2`.
+
+    Fetches takes 001-012 of every content (walk, the two turns, run, three
+    waves, three raises) in every style of the second set of the Bandai
+    Namco Research Motion dataset
+    (BandaiNamcoResearchInc/Bandai-Namco-Research-Motiondataset, a fixed
+    commit): 840 BVH files with the JSON label of each, ``content_label.txt``
+    and ``style_label.txt`` (the label names) and the licence, into
+    ``data_home/bandai_dataset2/`` (174 MB), or only the cells and takes
+    asked for.  Files already there with the right SHA-256 are not
+    downloaded again.  The later takes of the dataset are not fetched.
+
+    The data are licensed under Creative Commons Attribution-NonCommercial
+    4.0 (``LICENSE``); cite Kobayashi et al., "Motion Capture Dataset for
+    Practical Use of AI-based Motion Editing and Stylization" (2023,
+    arXiv:2306.08861), as the repository asks.
+
+    Parameters
+    ----------
+    data_home : path-like, default=None
+        See :func:`get_data_home`; created if needed.
+    contents : str or list of str, default=None
+        The contents to fetch, such as ``"run"`` or ``["walk", "run"]``;
+        ``None`` means all ten.
+    styles : str or list of str, default=None
+        The styles to fetch, such as ``"elderly"``; ``None`` means all seven.
+    takes : int or list of int, default=None
+        The take numbers to fetch, from 1 to 12; ``None`` means all twelve.
+    base_url : str, default=None
+        See :func:`fetch_cmu35`.
+    timeout : float, default=60.0
+        Seconds to wait for the server.
+    verbose : bool, default=True
+        See :func:`fetch_cmu35`.
+
+    Returns
+    -------
+    data_home : pathlib.Path
+        The folder, ready for :func:`load_bandai_dataset2`.
+
+    Raises
+    ------
+    ValueError
+        If a content, style or take is not one of the corpus's.
+    OSError
+        If a download fails or a file does not have the expected SHA-256
+        (the bad file is deleted).
+
+    Examples
+    --------
+    >>> from sklearn_crbm.datasets import fetch_bandai_dataset2, load_bandai_dataset2
+    >>> cells = dict(contents="run", styles=["elderly", "normal"], takes=[1, 2])
+    >>> home = fetch_bandai_dataset2(**cells)  # doctest: +SKIP
+    >>> runs = load_bandai_dataset2(home, **cells)  # doctest: +SKIP
+    """
+    wanted = set(dataset2_filenames(*dataset2_selection(contents, styles, takes)))
+    wanted |= {name.removesuffix(".bvh") + ".json" for name in wanted}
+    files = [
+        remote
+        for remote in BANDAI_DATASET2_FILES
+        if remote.filename in wanted or not remote.filename.startswith("dataset-2_")
+    ]
+    return _fetch_files(files, data_home, base_url, timeout, verbose)
 
 
 def _fetch_files(files, data_home, base_url, timeout, verbose):

@@ -167,6 +167,7 @@ def animate_motions(
     view="auto",
     horizontal=None,
     panel_width=2.6,
+    ncols=None,
     figure=None,
 ):
     """Animate several sequences side by side, frame by frame together.
@@ -174,6 +175,8 @@ def animate_motions(
     Real motion beside generated motion, or one generated sequence per
     style: each sequence gets its own panel, all seen from the same side
     (up axis vertical), and every panel shows the same frame.  With
+    ``ncols``, the panels fill a grid row by row (contents down, styles
+    across).  With
     ``proba``, a panel below plots the probability of each style over the frames (see
     :func:`~sklearn_crbm.plotting.plot_style_probabilities`) with a line at
     the frame shown.  Save it with :func:`save_animation`, at
@@ -208,6 +211,9 @@ def animate_motions(
         As for :func:`animate_motion`.
     panel_width : float, default=2.6
         Width of each panel, in inches (of a new figure).
+    ncols : int, default=None
+        Panels per row; the sequences fill the rows in order.  ``None``:
+        all in one row.
     figure : matplotlib Figure, default=None
         Where to draw (an empty figure); default a new one.
 
@@ -238,23 +244,34 @@ def animate_motions(
     sequences = list(sequences)
     if not sequences:
         raise ValueError("sequences must hold at least one sequence.")
+    if ncols is None:
+        ncols = len(sequences)
+    if isinstance(ncols, bool) or not isinstance(ncols, Integral) or ncols < 1:
+        raise ValueError(f"ncols must be a positive integer, got {ncols!r}.")
+    ncols = min(ncols, len(sequences))
+    n_rows = -(-len(sequences) // ncols)
     titles = [None] * len(sequences) if titles is None else list(titles)
     if len(titles) != len(sequences):
         raise ValueError(
             f"titles must name each of the {len(sequences)} sequences, got "
             f"{len(titles)} titles."
         )
-    rows = 1 if proba is None else 2
+    rows = n_rows + (proba is not None)
     if figure is None:
         figure = plt.figure(
-            figsize=(max(panel_width * len(sequences), 5.0), 3.0 + 2.0 * (rows - 1))
+            figsize=(
+                max(panel_width * ncols, 5.0),
+                3.0 * n_rows + 2.0 * (rows - n_rows),
+            )
         )
     drawn = [_drawn(skeleton, data, feature_names, horizontal) for data in sequences]
     view = _chosen_view(view, horizontal, [coordinates for _, coordinates in drawn])
-    grid = figure.add_gridspec(rows, len(sequences), height_ratios=[3, 2][:rows])
+    grid = figure.add_gridspec(
+        rows, ncols, height_ratios=[3] * n_rows + [2] * (rows - n_rows)
+    )
     updates, n_frames = [], 0
     for k, ((body, coordinates), title) in enumerate(zip(drawn, titles, strict=True)):
-        ax = figure.add_subplot(grid[0, k])
+        ax = figure.add_subplot(grid[k // ncols, k % ncols])
         if title is not None:
             ax.set_title(title, fontsize=9)
         update, length = _motion_updater(
@@ -265,7 +282,7 @@ def animate_motions(
     if proba is not None:
         from ._figures import plot_style_probabilities
 
-        ax = figure.add_subplot(grid[1, :])
+        ax = figure.add_subplot(grid[n_rows, :])
         plot_style_probabilities(proba, classes=classes, frame_rate=frame_rate, ax=ax)
         ax.legend(fontsize=7, ncols=4, loc="upper right")
         cursor = ax.axvline(0.0, color="0.2", linewidth=1.0)

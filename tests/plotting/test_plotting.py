@@ -328,6 +328,32 @@ def test_animate_motions_sees_every_panel_from_one_side(data_home, tmp_path):
         )
 
 
+def test_animate_motions_fills_a_grid_row_by_row(walker, tmp_path):
+    """Contents down, styles across: five sequences in rows of two, the
+    probabilities below them all."""
+    sequences = [walker.data[:6] + k for k in range(5)]
+    titles = [f"panel {k}" for k in range(5)]
+    proba = np.full((6, 2), 0.5)
+    animation = animate_motions(
+        walker.skeleton, sequences, titles=titles, ncols=2, proba=proba
+    )
+    *panels, below = animation._fig.axes
+    assert [ax.get_title() for ax in panels] == titles
+    spans = [ax.get_subplotspec() for ax in panels]
+    assert [(s.rowspan.start, s.colspan.start) for s in spans] == [
+        (0, 0), (0, 1), (1, 0), (1, 1), (2, 0)
+    ]  # fmt: skip
+    assert below.get_subplotspec().rowspan.start == 3
+    assert below.get_subplotspec().colspan == range(0, 2)
+    save_animation(animation, tmp_path / "grid.gif", dpi=10)
+    assert Image.open(tmp_path / "grid.gif").n_frames == 6
+    one_row = animate_motions(walker.skeleton, sequences[:3])
+    assert [ax.get_subplotspec().rowspan.start for ax in one_row._fig.axes] == [0] * 3
+    save_animation(one_row, tmp_path / "row.gif", dpi=10)
+    with pytest.raises(ValueError, match="ncols must be a positive integer"):
+        animate_motions(walker.skeleton, sequences, ncols=0)
+
+
 @pytest.mark.parametrize("frame_rate", [15.0, 30.0, 24.0, 12.5])
 def test_gif_lasts_its_frames_over_the_frame_rate(walker, tmp_path, frame_rate):
     """GIF delays are whole hundredths: they alternate so that every stretch
