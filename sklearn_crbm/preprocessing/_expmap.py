@@ -25,6 +25,7 @@ from ._layout import (
     check_encoded,
     expmap_layout,
     find_euler_blocks,
+    frame_chunks,
     input_names,
     moving_root,
     output_dtype,
@@ -32,19 +33,6 @@ from ._layout import (
 )
 
 __all__ = ["ExpMapEncoder"]
-
-# Frames :meth:`ExpMapEncoder.transform` converts at a time: the rotation
-# matrices of a chunk and their temporaries take a few MB per bone, not the
-# gigabytes of a whole corpus's.
-CHUNK_FRAMES = 4096
-
-
-def _chunks(n_frames):
-    """Slices of at most ``CHUNK_FRAMES`` consecutive frames covering ``n_frames``."""
-    return [
-        slice(start, min(start + CHUNK_FRAMES, n_frames))
-        for start in range(0, n_frames, CHUNK_FRAMES)
-    ]
 
 
 def _unwrap_rows(r, rows, sequences, previous):
@@ -313,7 +301,7 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
             columns_out = self._block_starts[members][:, None] + np.arange(3)
             reference = np.swapaxes(self.reference_rotations_[members], -1, -2)
             previous = None  # the last map of the chunk before, unwrapped
-            for rows in _chunks(X.shape[0]):
+            for rows in frame_chunks(X.shape[0]):
                 # in float64 whatever the dtype of X, as many frames at a time
                 # as keep the rotation matrices small
                 angles = X[rows][:, cols].astype(np.float64) * self._scale()

@@ -286,7 +286,7 @@ def test_chunks_give_the_maps_of_one_pass(monkeypatch):
     for continuous, dtype in itertools.product([False, True], [np.float64, np.float32]):
         encoder = ExpMapEncoder(skeleton, continuous=continuous, reference="mean")
         whole = encoder.fit_transform(X.astype(dtype), sequence_ids=ids)
-        monkeypatch.setattr("sklearn_crbm.preprocessing._expmap.CHUNK_FRAMES", 7)
+        monkeypatch.setattr("sklearn_crbm.preprocessing._layout.CHUNK_FRAMES", 7)
         chunked = encoder.transform(X.astype(dtype), sequence_ids=ids)
         monkeypatch.undo()
         assert chunked.dtype == dtype
