@@ -1,8 +1,7 @@
 """Training and generation on a large corpus: CPU (1 and all threads) and GPU.
 
-Issue 18's configuration: 10^6 synthetic frames x 100 channels
-(``_common.synthetic_motion``; a real corpus: ``bench_memory.py
---corpus``); 1000 hidden units, order 3, float64 and
+Issue 18's configuration: 10^6 synthetic frames x 100 channels (a real
+corpus: ``bench_memory.py``); 1000 hidden units, order 3, float64 and
 float32; best of ``--repeats``.  Rows: ``train`` (an epoch of
 ``partial_fit``, batch 100 and 1000, 1 and all threads), ``products`` (its
 matrix products alone, ``/ products`` at most 1.3), ``sample`` (1000
@@ -49,13 +48,8 @@ def first_sequences(ids, n_frames):
 
 
 def model(args, batch_size):
-    return ConditionalRBM(
-        args.components,
-        order=args.order,
-        batch_size=batch_size,
-        n_iter=1,
-        random_state=0,
-    )
+    params = dict(order=args.order, batch_size=batch_size, n_iter=1, random_state=0)
+    return ConditionalRBM(args.components, **params)
 
 
 def started(args, batch_size, X, sequence_ids):
@@ -64,10 +58,7 @@ def started(args, batch_size, X, sequence_ids):
 
 
 def peak_mb(func):
-    """Peak memory that ``func`` allocates, in MB (numpy reports to tracemalloc).
-
-    Run apart from the timed call: tracing slows allocation.
-    """
+    """Peak MB ``func`` allocates (tracemalloc: run apart from timed calls)."""
     tracemalloc.start()
     try:
         func()
