@@ -445,10 +445,7 @@ def threadpool_limits(threads):
 
 
 def seconds(func, repeats=1, sync=lambda: None):
-    """Best wall-clock seconds of ``repeats`` calls of ``func``.
-
-    ``sync`` waits for an accelerator before and after each call.
-    """
+    """Best wall-clock seconds of ``repeats`` calls (``sync``: wait for a device)."""
     times = []
     for _ in range(repeats):
         sync()
@@ -460,11 +457,7 @@ def seconds(func, repeats=1, sync=lambda: None):
 
 
 def time_both(func):
-    """Wall-clock and process CPU seconds of one call of ``func``.
-
-    With one BLAS thread the CPU time leaves out the time spent waiting for
-    a core: the steadier measure on a shared machine.
-    """
+    """Wall-clock and CPU seconds of ``func()`` (CPU: steadier when shared)."""
     wall, cpu = time.perf_counter(), time.process_time()
     func()
     return time.perf_counter() - wall, time.process_time() - cpu
@@ -485,23 +478,15 @@ def gemm_peak(dtype, n=2000, repeats=3):
 
 
 def cd_epoch_flops(n_frames, n_features, n_components, order, cd_steps=1):
-    """FLOPs of the matrix products of one CD-k epoch (2 m n k per product).
-
-    Per frame: dynamic biases, positive hidden input, per step the
-    reconstruction and the negative hidden input, the W statistics and the
-    directed statistics.  Elementwise work is not counted.
-    """
+    """FLOPs (2 m n k a product) of one CD-k epoch's matrix products, per frame
+    dynamic biases, hidden input, k reconstructions and statistics."""
     d, h, k = n_features, n_components, order * n_features
     per_frame = k * (d + h) + d * h + cd_steps * 2 * d * h + 2 * d * h + (d + h) * k
     return 2 * n_frames * per_frame
 
 
 def frames_with_history(sequence_ids, order):
-    """Indices of the frames with ``order`` past frames in their own sequence.
-
-    The frames a model of that order trains on and scores (sequences are
-    contiguous runs of equal ids).
-    """
+    """The frames with ``order`` past frames in their sequence (runs of ids)."""
     ids = np.asarray(sequence_ids)
     starts = np.r_[0, np.flatnonzero(ids[1:] != ids[:-1]) + 1]
     lengths = np.diff(np.r_[starts, len(ids)])
@@ -562,11 +547,8 @@ def child_json(arguments, env=None):
 
 # ------------------------------------------------------------------ output
 def print_table(rows, columns, title=None):
-    """Print ``rows`` (dicts) as a Markdown table and return its text.
-
-    ``columns``: ``(key, header, format)``, or a key alone (its own header,
-    the value as it is).
-    """
+    """Print ``rows`` (dicts) as a Markdown table and return its text;
+    ``columns``: ``(key, header, format)`` or a key (as header, unformatted)."""
     columns = [(c, c, "") if isinstance(c, str) else c for c in columns]
     header = [(name, str.ljust) for _, name, _ in columns]
     body = [[_cell(row.get(key), spec) for key, _, spec in columns] for row in rows]
@@ -591,10 +573,7 @@ def _cell(value, spec):
 
 
 def write_json(name, output, **payload):
-    """Write ``payload`` with the machine and the package under test.
-
-    To ``output``, by default ``benchmarks/results/<name>.json``.
-    """
+    """Write ``payload``, the machine and package to ``output`` (or results/)."""
     path = Path(output) if output else RESULTS / f"{name}.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     package = package_description()

@@ -1,8 +1,7 @@
 """Training and generation on a large corpus: CPU (1 and all threads) and GPU.
 
-Issue 18's configuration: 10^6 synthetic frames x 100 channels
-(``_common.synthetic_motion``) or every BVH/AMC file of ``--corpus``
-(preprocessed as the demo does); 1000 hidden units, order 3, float64 and
+Issue 18's configuration: 10^6 synthetic frames x 100 channels (a real
+corpus: ``bench_memory.py``); 1000 hidden units, order 3, float64 and
 float32; best of ``--repeats``.  Rows: ``train`` (an epoch of
 ``partial_fit``, batch 100 and 1000, 1 and all threads), ``products`` (its
 matrix products alone, ``/ products`` at most 1.3), ``sample`` (1000
@@ -42,27 +41,6 @@ from _common import (  # noqa: E402
 from sklearn_crbm import ConditionalRBM  # noqa: E402
 
 
-def load_corpus(args, dtype):
-    """``(X, sequence_ids, description)`` of the corpus, in ``dtype``."""
-    if args.corpus is None:
-        n_sequences = max(1, args.frames // 1000)
-        X, ids = synthetic_motion(args.frames, args.features, n_sequences, dtype)
-        return X, ids, f"synthetic, {args.frames} x {args.features}"
-    from sklearn_crbm.datasets import read_amc_folder, read_bvh_folder
-    from sklearn_crbm.preprocessing import make_motion_preprocessor
-
-    folder = os.path.expanduser(args.corpus)
-    try:
-        bunch = read_bvh_folder(folder, pattern="**/*.bvh")
-    except FileNotFoundError:
-        bunch = read_amc_folder(folder, pattern="**/*.amc", frame_rate=30.0)
-    with sklearn.config_context(enable_metadata_routing=True):
-        pre = make_motion_preprocessor(bunch.skeleton)
-        X = pre.fit_transform(bunch.data, sequence_ids=bunch.sequence_ids)
-    X = np.ascontiguousarray(X, dtype=dtype)
-    return X, np.asarray(bunch.sequence_ids), f"{folder}, {X.shape[0]} x {X.shape[1]}"
-
-
 def first_sequences(ids, n_frames):
     """Rows of the first whole sequences holding at least ``n_frames`` frames."""
     stops = np.r_[np.flatnonzero(ids[1:] != ids[:-1]) + 1, len(ids)]
@@ -70,13 +48,8 @@ def first_sequences(ids, n_frames):
 
 
 def model(args, batch_size):
-    return ConditionalRBM(
-        args.components,
-        order=args.order,
-        batch_size=batch_size,
-        n_iter=1,
-        random_state=0,
-    )
+    params = dict(order=args.order, batch_size=batch_size, n_iter=1, random_state=0)
+    return ConditionalRBM(args.components, **params)
 
 
 def started(args, batch_size, X, sequence_ids):
@@ -85,10 +58,7 @@ def started(args, batch_size, X, sequence_ids):
 
 
 def peak_mb(func):
-    """Peak memory that ``func`` allocates, in MB (numpy reports to tracemalloc).
-
-    Run apart from the timed call: tracing slows allocation.
-    """
+    """Peak MB ``func`` allocates (tracemalloc: run apart from timed calls)."""
     tracemalloc.start()
     try:
         func()
@@ -208,7 +178,6 @@ def main(argv=None):
     add = parser.add_argument
     add("--frames", type=int, default=1_000_000)
     add("--features", type=int, default=100)
-    add("--corpus", default=None, help="folder of BVH or AMC files")
     add("--components", type=int, default=1000)
     add("--order", type=int, default=3)
     add("--batch-sizes", type=int, nargs="+", default=[100, 1000])
@@ -227,7 +196,9 @@ def main(argv=None):
     rows, corpora = [], {}
     for dtype_name in args.dtypes:
         dtype = np.dtype(dtype_name).type
-        X, ids, corpora[dtype_name] = load_corpus(args, dtype)
+        n_sequences = max(1, args.frames // 1000)
+        X, ids = synthetic_motion(args.frames, args.features, n_sequences, dtype)
+        corpora[dtype_name] = f"synthetic, {args.frames} x {args.features}"
         for threads in args.threads:
             rows.extend(cpu_rows(args, X, ids, dtype, threads))
         if torch is not None:

@@ -21,7 +21,7 @@ from ..utils._random import add_history_noise, rng_from
 from ..utils._sequences import balanced_batches, frame_history, shuffled_batches
 from ._gibbs import mean_field_prediction
 
-__all__ = ["ProgressMonitor", "Schedule", "train_epochs"]
+__all__ = ["ProgressMonitor", "Schedule", "UpdateBudget", "train_epochs"]
 
 # Frames the progress report predicts one step ahead (evenly spaced).
 MONITOR_FRAMES = 1000
@@ -34,6 +34,39 @@ ONE_STEP_EXPLANATION = (
     "the motion goes on, and its generated motion tends to die out: train "
     "for more updates (n_iter) or on more frames."
 )
+
+
+@dataclass(frozen=True)
+class UpdateBudget:
+    """What ``n_iter="auto"`` trains on a corpus, in minibatch updates.
+
+    ``epochs`` epochs, but at least ``min_updates`` and at most
+    ``max_updates`` minibatch updates, in whole epochs (at least one): a
+    corpus of short takes gets as many updates as a larger one, and a large
+    corpus the updates of a medium one, each frame seen fewer times.  When
+    ``max_updates`` shortens training, the epochs that ``momentum_delay``
+    and ``momentum_ramp`` count are ``max_updates / epochs`` updates long
+    (:meth:`epoch_updates`), so that momentum starts at the same fraction
+    of training whatever the corpus's size.
+    """
+
+    epochs: int
+    min_updates: int = 0
+    max_updates: int | None = None
+
+    def n_epochs(self, n_frames, batch_size):
+        """The epochs to train on ``n_frames`` trainable frames."""
+        batches = math.ceil(n_frames / batch_size)
+        epochs = max(self.epochs, math.ceil(self.min_updates / batches))
+        if self.max_updates is not None and epochs * batches > self.max_updates:
+            epochs = max(1, self.max_updates // batches)
+        return epochs
+
+    def epoch_updates(self, n_frames, batch_size):
+        """The updates an epoch of the momentum schedule lasts (None: an epoch's)."""
+        if self.n_epochs(n_frames, batch_size) >= self.epochs:
+            return None
+        return self.max_updates / self.epochs
 
 
 @dataclass(frozen=True)
@@ -51,14 +84,22 @@ class Schedule:
     history_noise_fraction: float
     momentum_ramp: int = 0
     max_step: float | None = None
+    epoch_updates: float | None = None
 
     @classmethod
-    def of(cls, estimator):
+    def of(cls, estimator, **given):
         """The schedule an estimator's parameters of the same names give
-        (those it does not have keep their defaults)."""
-        params = estimator.get_params(deep=False)
+        (those it does not have keep their defaults), and ``given``."""
+        params = {**estimator.get_params(deep=False), **given}
         names = [name for name in cls.__dataclass_fields__ if name in params]
         return cls(**{name: params[name] for name in names})
+
+    def momentum_of_update(self, updates_done, batches_per_epoch):
+        """Momentum of the update after ``updates_done``, when ``epoch_updates``
+        updates count as an epoch (None: ``batches_per_epoch``)."""
+        if self.epoch_updates is None:
+            return self.momentum_at(updates_done // batches_per_epoch)
+        return self.momentum_at(int(updates_done // self.epoch_updates))
 
     def momentum_at(self, epochs_done):
         """Momentum of the epoch after ``epochs_done``: none for the first
@@ -295,12 +336,13 @@ def train_epochs(
         # minibatches are planned with numpy; the math draws on X's device
         math_rng = array_random(rng, X)
         done = epochs_done + epoch
-        momentum = schedule.momentum_at(done)
         squared_error = 0.0
         batches = plan_batches(frames, schedule.batch_size, rng)
+        n_batches = len(batches)
         if ops is not np:  # the epoch's plan reaches the device in one copy
             batches = to_device_batches(batches, ops)
-        for batch in batches:
+        for i, batch in enumerate(batches):
+            momentum = schedule.momentum_of_update(done * n_batches + i, n_batches)
             n = batch.shape[0]
             visible = ops.take(X, batch, axis=0, out=workspace.visible(n), mode="clip")
             history = frame_history(

@@ -69,8 +69,8 @@ class ConditionalRBM(BaseLayerModel):
     average_fraction : float in [0, 1), default=0.25
         Fraction of the last epochs whose parameters :meth:`fit` averages.
     n_iter : int or "auto", default="auto"
-        Number of epochs.  ``"auto"``: enough for 25,000 minibatch updates,
-        and at least 1000 (:ref:`training`).
+        Number of epochs.  ``"auto"``: 1000, but at least 25,000 and at most
+        100,000 minibatch updates (:ref:`training`).
     ais_steps, ais_chains : int, default=50, 2
         Annealing steps, and chains per frame, of :meth:`score`.
     early_stopping : bool, default=False

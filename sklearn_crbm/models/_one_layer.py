@@ -17,7 +17,12 @@ from sklearn.utils._array_api import get_namespace_and_device, move_to
 from sklearn.utils._param_validation import Interval
 from sklearn.utils.validation import validate_data
 
-from .._engines._training import ProgressMonitor, Schedule, train_epochs
+from .._engines._training import (
+    ProgressMonitor,
+    Schedule,
+    UpdateBudget,
+    train_epochs,
+)
 from ..utils._array_api import array_ops
 from ..utils._fitting import unfitted_on_error
 from ..utils._random import rng_from
@@ -30,11 +35,6 @@ from ..utils._threads import batch_rows, limit_blas_threads
 from ._base import BaseCRBM
 
 __all__ = ["BaseLayerModel"]
-
-# ``n_iter="auto"``: at least AUTO_EPOCHS epochs, and enough of them for
-# AUTO_UPDATES minibatch updates (what 1000 epochs of 25 minibatches give:
-# CMU subject 35, 26-28 minibatches an epoch, trains 1000 epochs).
-AUTO_EPOCHS, AUTO_UPDATES = 1000, 25_000
 
 
 class BaseLayerModel(BaseCRBM):
@@ -63,6 +63,13 @@ class BaseLayerModel(BaseCRBM):
         "average_fraction": [Interval(Real, 0, 1, closed="left")],
     }
 
+    # ``n_iter="auto"``: 1000 epochs (CMU subject 35, 26-28 minibatches an
+    # epoch, trains 1000 epochs), at least 25,000 minibatch updates (what
+    # 1000 epochs of 25 minibatches give) and at most 100,000 (a corpus of
+    # more than 10,000 frames: the whole Bandai dataset-2 development corpus,
+    # 132,297 frames, trains 75 epochs instead of 1000).
+    _update_budget = UpdateBudget(1000, min_updates=25_000, max_updates=100_000)
+
     # Private state that a failed fit must forget with the fitted attributes:
     # the layer (which the public attributes view) and the velocities.
     _training_state = ("_layer", "_velocity")
@@ -79,6 +86,10 @@ class BaseLayerModel(BaseCRBM):
 
     def _start_parameters(self, X, frames, context):
         """Change the random start of the layer where the parameters ask for it."""
+
+    def _training_frames(self, frames, context):
+        """The frames an epoch trains on (each trainable frame once, by default)."""
+        return frames
 
     # ------------------------------------------------------------------ fit
 
@@ -134,7 +145,7 @@ class BaseLayerModel(BaseCRBM):
                 self._train_with_early_stopping(X, sequences, context)
             else:
                 self._start_parameters(X, frames, context)
-                n_epochs = self._n_epochs(len(frames))
+                n_epochs = self._n_epochs(len(self._training_frames(frames, context)))
                 n_averaged = math.ceil(self.average_fraction * n_epochs)
                 self._train(X, frames, n_epochs, n_averaged, context)
             self._keep_seeds(X, sequences, context=context)
@@ -195,16 +206,14 @@ class BaseLayerModel(BaseCRBM):
         return [self._new_layer(n_features, 0, np.float64)]
 
     def _n_epochs(self, n_frames):
-        """The epochs ``fit`` trains on ``n_frames`` trainable frames.
+        """The epochs ``fit`` trains on ``n_frames`` frames an epoch.
 
-        ``n_iter``, or for ``"auto"`` enough epochs for ``AUTO_UPDATES``
-        minibatch updates, at least ``AUTO_EPOCHS``: a corpus of short takes
-        gets as many parameter updates as a larger one.
+        ``n_iter``, or for ``"auto"`` those of the class's
+        :class:`~sklearn_crbm._engines._training.UpdateBudget`.
         """
         if self.n_iter != "auto":
             return self.n_iter
-        batches_per_epoch = math.ceil(n_frames / self.batch_size)
-        return max(AUTO_EPOCHS, math.ceil(AUTO_UPDATES / batches_per_epoch))
+        return self._update_budget.n_epochs(n_frames, self.batch_size)
 
     def _ais_settings(self):
         return self.ais_steps, self.ais_chains
@@ -249,12 +258,17 @@ class BaseLayerModel(BaseCRBM):
     def _train(self, X, frames, n_epochs, n_averaged=0, context=None):
         """``n_epochs`` epochs of CD; the parameters kept are the mean of those
         at the ends of the last ``n_averaged`` epochs (0: the last epoch's)."""
+        frames = self._training_frames(frames, context)
+        epoch_updates = None
+        if self.n_iter == "auto":
+            budget = self._update_budget
+            epoch_updates = budget.epoch_updates(len(frames), self.batch_size)
         self._layer, self._velocity, self.reconstruction_error_ = train_epochs(
             self._layer,
             self._velocity,
             X,
             frames,
-            Schedule.of(self),
+            Schedule.of(self, epoch_updates=epoch_updates),
             self.random_state_,
             n_epochs,
             epochs_done=self.n_iter_,
@@ -292,7 +306,9 @@ class BaseLayerModel(BaseCRBM):
         seed = int(rng.integers(np.iinfo(np.int32).max))
         self.validation_scores_ = []
         best, best_iter, best_layer = -np.inf, 0, None
-        n_epochs = self._n_epochs(len(train_frames))
+        n_epochs = self._n_epochs(
+            len(self._training_frames(train_frames, train_context))
+        )
         while self.n_iter_ < n_epochs:
             epochs = min(self.validation_interval, n_epochs - self.n_iter_)
             self._train(X_train, train_frames, epochs, context=train_context)

@@ -25,6 +25,7 @@ from ._layout import (
     check_encoded,
     expmap_layout,
     find_euler_blocks,
+    frame_chunks,
     input_names,
     moving_root,
     output_dtype,
@@ -32,6 +33,24 @@ from ._layout import (
 )
 
 __all__ = ["ExpMapEncoder"]
+
+
+def _unwrap_rows(r, rows, sequences, previous):
+    """Unwrap the maps ``r`` of frames ``rows`` in place, sequence by sequence.
+
+    A sequence that began in an earlier chunk continues from ``previous``
+    (its last map, unwrapped), so chunks give the maps of a whole pass.
+    """
+    starts = np.clip(sequences.starts, rows.start, rows.stop)
+    stops = np.clip(sequences.stops, rows.start, rows.stop)
+    for start, stop, first in zip(starts, stops, sequences.starts, strict=True):
+        if start == stop:
+            continue
+        part = slice(start - rows.start, stop - rows.start)
+        if first < start:  # the sequence's earlier frames were in the chunk before
+            r[part] = unwrap_expmap(np.concatenate([previous[None], r[part]]))[1:]
+        else:
+            r[part] = unwrap_expmap(r[part])
 
 
 class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
@@ -180,7 +199,9 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         self : ExpMapEncoder
             The fitted encoder.
         """
-        X = validate_data(self, X, dtype=np.float64, ensure_all_finite="allow-nan")
+        X = validate_data(
+            self, X, dtype=[np.float64, np.float32], ensure_all_finite="allow-nan"
+        )
         check_sequence_ids(sequence_ids, X.shape[0])
         names = input_names(
             self,
@@ -209,7 +230,8 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         root = moving_root(self._names_in, X, self.skeleton)
         for i, block in enumerate(self._blocks):
             if block.bone != root:
-                angles = X[:, list(block.columns)] * self._scale()
+                angles = X[:, list(block.columns)].astype(np.float64)
+                angles *= self._scale()
                 references[i] = mean_rotation(euler_to_matrix(angles, block.axes))
         return references
 
@@ -265,23 +287,30 @@ class ExpMapEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator):
         check_is_fitted(self)
         dtype = output_dtype(X)
         X = validate_data(
-            self, X, reset=False, dtype=np.float64, ensure_all_finite="allow-nan"
+            self,
+            X,
+            reset=False,
+            dtype=[np.float64, np.float32],
+            ensure_all_finite="allow-nan",
         )
         sequences = check_sequence_ids(sequence_ids, X.shape[0])
-        out = np.empty((X.shape[0], len(self._names_out)), dtype=np.float64)
+        out = np.empty((X.shape[0], len(self._names_out)), dtype=dtype)
         out[:, self._passthrough[:, 0]] = X[:, self._passthrough[:, 1]]
         for axes, members in self._groups().items():
             cols = np.array([self._blocks[i].columns for i in members])
-            angles = X[:, cols] * self._scale()  # (n_frames, n_bones, k)
-            reference = self.reference_rotations_[members]
-            R = np.swapaxes(reference, -1, -2) @ euler_to_matrix(angles, axes)
-            r = matrix_to_expmap(R)
-            if self.continuous:
-                for start, stop in zip(sequences.starts, sequences.stops, strict=True):
-                    r[start:stop] = unwrap_expmap(r[start:stop])
-            starts = self._block_starts[members]
-            out[:, starts[:, None] + np.arange(3)] = r
-        return out.astype(dtype, copy=False)
+            columns_out = self._block_starts[members][:, None] + np.arange(3)
+            reference = np.swapaxes(self.reference_rotations_[members], -1, -2)
+            previous = None  # the last map of the chunk before, unwrapped
+            for rows in frame_chunks(X.shape[0]):
+                # in float64 whatever the dtype of X, as many frames at a time
+                # as keep the rotation matrices small
+                angles = X[rows][:, cols].astype(np.float64) * self._scale()
+                r = matrix_to_expmap(reference @ euler_to_matrix(angles, axes))
+                if self.continuous:
+                    _unwrap_rows(r, rows, sequences, previous)
+                    previous = r[-1]
+                out[rows, columns_out] = r
+        return out
 
     def inverse_transform(self, X, *, sequence_ids=None):
         """Euler angles back from exponential maps, in the original layout.

@@ -246,6 +246,20 @@ def expmap_feature_names(skeleton):
     return expmap_layout(names, find_euler_blocks(names, skeleton))[0]
 
 
+# Frames the encoders convert at a time: the temporaries of a chunk (the
+# rotation matrices of its bones, a copy of its channels) take a few MB, not
+# the gigabytes of a whole corpus's.
+CHUNK_FRAMES = 4096
+
+
+def frame_chunks(n_frames):
+    """Slices of at most ``CHUNK_FRAMES`` consecutive frames covering ``n_frames``."""
+    return [
+        slice(start, min(start + CHUNK_FRAMES, n_frames))
+        for start in range(0, n_frames, CHUNK_FRAMES)
+    ]
+
+
 def output_dtype(X):
     """The dtype an encoder returns for ``X``: float32 for float32 input, else
     float64 (encoders compute in float64 either way)."""

@@ -23,6 +23,7 @@ from ._layout import (
     check_encoded,
     check_skeleton,
     expmap_feature_names,
+    frame_chunks,
     input_names,
     moving_root,
     output_dtype,
@@ -486,7 +487,8 @@ class RootRelativeEncoder(VersionedPickleMixin, TransformerMixin, BaseEstimator)
         encoded["height"] = position[:, 2]
 
         out = np.empty_like(X)
-        out[:, self._pass_out] = X[:, self._pass_in]
+        for rows in frame_chunks(n):  # no temporary copy of all the other channels
+            out[rows, self._pass_out] = X[rows][:, self._pass_in]
         out[:, self._root_out] = np.column_stack([encoded[c] for c in self._outputs])
         return out.astype(dtype, copy=False)
 

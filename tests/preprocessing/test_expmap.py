@@ -1,6 +1,7 @@
 """ExpMapEncoder: Euler angles <-> exponential maps."""
 
 import itertools
+import tracemalloc
 
 import numpy as np
 import pytest
@@ -272,3 +273,38 @@ def test_mean_reference_measures_bones_from_their_mean_but_not_the_root():
     # every bone's rotation comes back (the thigh as an equivalent triple)
     rotations = walker.skeleton.local_rotations(X)
     assert np.abs(walker.skeleton.local_rotations(back) - rotations).max() < 1e-13
+
+
+def test_chunks_give_the_maps_of_one_pass(monkeypatch):
+    # a bone turning through pi in sequences that cross the chunk boundaries
+    skeleton = _skeleton(("a", ("rx", "ry", "rz"), "zxy"), ("b", ("rz",), "z"))
+    rng = np.random.default_rng(0)
+    turn = np.concatenate([np.linspace(150, 400, 23), np.linspace(100, -250, 17)])
+    X = np.column_stack([rng.uniform(-179, 179, size=(40, 3)), turn])
+    X[:, 3] = (X[:, 3] + 180) % 360 - 180
+    ids = np.repeat([0, 1], [23, 17])
+    for continuous, dtype in itertools.product([False, True], [np.float64, np.float32]):
+        encoder = ExpMapEncoder(skeleton, continuous=continuous, reference="mean")
+        whole = encoder.fit_transform(X.astype(dtype), sequence_ids=ids)
+        monkeypatch.setattr("sklearn_crbm.preprocessing._layout.CHUNK_FRAMES", 7)
+        chunked = encoder.transform(X.astype(dtype), sequence_ids=ids)
+        monkeypatch.undo()
+        assert chunked.dtype == dtype
+        np.testing.assert_array_equal(chunked, whole)
+    assert np.abs(np.diff(whole[:23, 5])).max() < 0.2  # unwrapped through pi
+
+
+def test_transform_adds_little_beyond_its_output():
+    # the rotation matrices of all frames at once took twenty times the output
+    walker = make_walker(n_sequences=8, n_frames=5000, random_state=0)
+    X = walker.data.astype(np.float32)
+    encoder = ExpMapEncoder(walker.skeleton).fit(X)
+    tracemalloc.start()
+    try:
+        base, _ = tracemalloc.get_traced_memory()
+        Z = encoder.transform(X)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert Z.dtype == np.float32
+    assert peak - base < Z.nbytes + 20e6  # a chunk's matrices: about 14 MB

@@ -2,6 +2,7 @@
 
 import dataclasses
 import pickle
+import tracemalloc
 import warnings
 
 import numpy as np
@@ -483,3 +484,18 @@ def test_a_yaw_comes_back_wrapped():
     E = encoder.transform(X)
     assert np.allclose(E, 1.0)
     np.testing.assert_allclose(encoder.inverse_transform(E), _wrap(X), atol=1e-12)
+
+
+def test_transform_copies_the_other_channels_without_a_temporary():
+    # all channels but the root's, gathered at once, were a second output
+    walker = make_walker(n_sequences=8, n_frames=5000, random_state=0)
+    E = ExpMapEncoder(walker.skeleton).fit_transform(walker.data)
+    encoder = RootRelativeEncoder(walker.skeleton).fit(E)
+    tracemalloc.start()
+    try:
+        base, _ = tracemalloc.get_traced_memory()
+        Z = encoder.transform(E)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak - base < 1.7 * Z.nbytes  # the output, and the root's few columns
