@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from sklearn_crbm import ConditionalRBM
+from sklearn_crbm import ConditionalRBM, FactoredCRBM, LabelledCRBM
 from sklearn_crbm._engines._training import Schedule, UpdateBudget
 from sklearn_crbm.datasets import load_cmu35, make_oscillations
 
@@ -115,3 +115,21 @@ def test_an_explicit_n_iter_is_kept():
     X, ids = make_oscillations(n_sequences=2, n_frames=40, random_state=0)
     model = ConditionalRBM(4, n_iter=7, random_state=0).fit(X, sequence_ids=ids)
     assert model.n_iter_ == 7
+
+
+@pytest.mark.parametrize(
+    "estimator, walks_frames, walks_epochs",
+    # the Bandai walks: 151 balanced minibatches an epoch (FactoredCRBM,
+    # 30,200 updates in 200 epochs), 11,211 trainable frames (LabelledCRBM)
+    [(FactoredCRBM(), 15_100, 200), (LabelledCRBM(), 11_211, 1000)],
+)
+def test_style_models_keep_their_epochs_on_the_walks_and_cap_a_corpus(
+    estimator, walks_frames, walks_epochs
+):
+    assert estimator._n_epochs(walks_frames) == walks_epochs
+    corpus_frames = 132_297  # the Bandai dataset-2 development corpus
+    epochs = estimator._n_epochs(corpus_frames)
+    assert epochs < walks_epochs
+    assert epochs * math.ceil(corpus_frames / 100) <= (
+        estimator._update_budget.max_updates
+    )

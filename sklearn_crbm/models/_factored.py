@@ -5,6 +5,7 @@ from numbers import Integral, Real
 import numpy as np
 from sklearn.utils._param_validation import Interval
 
+from .._engines._training import UpdateBudget
 from ..layers._factored import FactoredLayer
 from ..utils._array_api import to_numpy
 from ._base import FittedParameter
@@ -121,8 +122,9 @@ class FactoredCRBM(BaseStyleModel):
     average_fraction : float in [0, 1), default=0.0
         :meth:`fit` keeps the mean of the parameters over the last
         ``ceil(average_fraction * n_iter)`` epochs (0: the last epoch's).
-    n_iter : int, default=200
-        Number of epochs.
+    n_iter : int or "auto", default="auto"
+        Number of epochs.  ``"auto"``: 200, and at most 32,000 minibatch
+        updates (a large corpus trains fewer epochs; :ref:`training`).
     n_gibbs : int, default=100
         Alternating Gibbs iterations per generated frame in :meth:`sample`.
     priors : array-like of shape (n_classes,) or list of array-like, default=None
@@ -259,6 +261,10 @@ class FactoredCRBM(BaseStyleModel):
     (20, 6)
     """
 
+    # "auto": 200 epochs (the Bandai walks train all 200, 30,200 balanced
+    # updates); a corpus of more than 16,000 frames fewer, 32,000 updates.
+    _update_budget = UpdateBudget(200, max_updates=32_000)
+
     _parameter_constraints: dict = {
         **BaseStyleModel._parameter_constraints,
         "order": [Interval(Integral, 0, None, closed="left")],
@@ -312,7 +318,7 @@ class FactoredCRBM(BaseStyleModel):
         history_noise=1.0,
         history_noise_fraction=1.0,
         average_fraction=0.0,
-        n_iter=200,
+        n_iter="auto",
         n_gibbs=100,
         priors=None,
         ais_steps=50,
@@ -362,10 +368,10 @@ class FactoredCRBM(BaseStyleModel):
         self.validation_interval = validation_interval
         self.tol = tol
 
-    def _train(self, X, frames, n_epochs, n_averaged=0, context=None):
+    def _training_frames(self, frames, context):
         if self.balance_styles and self._labelled:
-            frames = balanced_frames(frames, context, blocks(self._factor_classes))
-        super()._train(X, frames, n_epochs, n_averaged, context)
+            return balanced_frames(frames, context, blocks(self._factor_classes))
+        return frames
 
     def _new_layer(self, n_features, n_context, dtype):
         return FactoredLayer(

@@ -4,6 +4,7 @@ from numbers import Integral, Real
 
 from sklearn.utils._param_validation import Interval, StrOptions
 
+from .._engines._training import UpdateBudget
 from ..layers._crbm import ORDER_CONSTRAINTS, CRBMLayer, hidden_order_of
 from ._base import FittedParameter
 from ._style import BaseStyleModel
@@ -43,7 +44,9 @@ class LabelledCRBM(BaseStyleModel):
     history_noise : float, default=1.0
     history_noise_fraction : float in (0, 1], default=0.5
     average_fraction : float in [0, 1), default=0.25
-    n_iter : int, default=1000
+    n_iter : int or "auto", default="auto"
+        Number of epochs.  ``"auto"``: 1000, and at most 120,000 minibatch
+        updates (a large corpus trains fewer epochs; :ref:`training`).
     n_gibbs : int, default=30
         Alternating Gibbs iterations per generated frame in :meth:`sample`.
     priors : array-like of shape (n_classes,) or list of array-like, default=None
@@ -147,6 +150,10 @@ class LabelledCRBM(BaseStyleModel):
     (20, 6)
     """
 
+    # "auto": 1000 epochs (the Bandai walks, 113 minibatches an epoch, train
+    # all of them); a larger corpus fewer, 120,000 updates.
+    _update_budget = UpdateBudget(1000, max_updates=120_000)
+
     _parameter_constraints: dict = {
         **BaseStyleModel._parameter_constraints,
         **ORDER_CONSTRAINTS,
@@ -180,7 +187,7 @@ class LabelledCRBM(BaseStyleModel):
         history_noise=1.0,
         history_noise_fraction=0.5,
         average_fraction=0.25,
-        n_iter=1000,
+        n_iter="auto",
         n_gibbs=30,
         priors=None,
         ais_steps=50,
