@@ -316,12 +316,14 @@ def _code(path):
     return ast.dump(tree)
 
 
-def cached_fit(model, X, sequence_ids, **fit_params):
+def cached_fit(model, X, sequence_ids, *, memory=False, **fit_params):
     """``(fitted model, fit seconds)``, read from the cache when it is there.
 
     The key is the model's class and parameters, the data (with the arrays
     in ``fit_params``, such as ``context``) and the package's code
-    (:func:`model_code_digest`), so changed code fits again.
+    (:func:`model_code_digest`), so changed code fits again.  With
+    ``memory``, also the MB by which the fit raised the process's peak
+    resident memory (:func:`peak_memory`; None when unknown).
     """
     key = hashlib.sha1(model_code_digest().encode())
     key.update(type(model).__name__.encode())
@@ -332,12 +334,35 @@ def cached_fit(model, X, sequence_ids, **fit_params):
         key.update(name.encode() + np.ascontiguousarray(value).tobytes())
     path = CACHE / f"{type(model).__name__}_{key.hexdigest()[:24]}.joblib"
     if path.exists():
-        return joblib.load(path)
-    fit = partial(model.fit, X, sequence_ids=sequence_ids, **fit_params)
-    result = (model, seconds(fit))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    joblib.dump(result, path)
-    return result
+        result = (*joblib.load(path), None)[:3]
+    else:
+        fit = partial(model.fit, X, sequence_ids=sequence_ids, **fit_params)
+        with peak_memory() as added:
+            fit_seconds = seconds(fit)
+        result = (model, fit_seconds, added.get("MB"))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        joblib.dump(result, path)
+    return result if memory else result[:2]
+
+
+@contextmanager
+def peak_memory():
+    """A dict whose ``"MB"`` is, on leaving, how far the block raised the peak
+    resident memory above the memory at its start (Linux; absent elsewhere)."""
+    added = {}
+    try:
+        Path("/proc/self/clear_refs").write_text("5")  # the peak := the current
+
+        def status(key):
+            text = Path("/proc/self/status").read_text()
+            return int(text.split(key + ":")[1].split()[0]) / 1024
+
+        start = status("VmRSS")
+    except (OSError, IndexError):
+        yield added
+        return
+    yield added
+    added["MB"] = status("VmHWM") - start
 
 
 # ----------------------------------------------------------------- fill-in
