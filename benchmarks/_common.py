@@ -9,6 +9,7 @@ API only.
 
 import argparse
 import ast
+import ctypes
 import hashlib
 import json
 import os
@@ -333,16 +334,20 @@ def cached_fit(model, X, sequence_ids, *, memory=False, **fit_params):
     for name, value in sorted(fit_params.items()):
         key.update(name.encode() + np.ascontiguousarray(value).tobytes())
     path = CACHE / f"{type(model).__name__}_{key.hexdigest()[:24]}.joblib"
+    memory_path = path.with_suffix(".MB")  # apart: older code reads the fit
     if path.exists():
-        result = (*joblib.load(path), None)[:3]
+        result = joblib.load(path)
     else:
         fit = partial(model.fit, X, sequence_ids=sequence_ids, **fit_params)
         with peak_memory() as added:
-            fit_seconds = seconds(fit)
-        result = (model, fit_seconds, added.get("MB"))
+            result = (model, seconds(fit))
         path.parent.mkdir(parents=True, exist_ok=True)
         joblib.dump(result, path)
-    return result if memory else result[:2]
+        memory_path.write_text(str(added.get("MB")))
+    if not memory:
+        return result
+    added = memory_path.read_text() if memory_path.exists() else "None"
+    return (*result, None if added == "None" else float(added))
 
 
 @contextmanager
@@ -350,7 +355,8 @@ def peak_memory():
     """A dict whose ``"MB"`` is, on leaving, how far the block raised the peak
     resident memory above the memory at its start (Linux; absent elsewhere)."""
     added = {}
-    try:
+    try:  # freed heap pages back to the system, so that new ones count
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
         Path("/proc/self/clear_refs").write_text("5")  # the peak := the current
 
         def status(key):
@@ -358,7 +364,7 @@ def peak_memory():
             return int(text.split(key + ":")[1].split()[0]) / 1024
 
         start = status("VmRSS")
-    except (OSError, IndexError):
+    except (OSError, IndexError, AttributeError):
         yield added
         return
     yield added

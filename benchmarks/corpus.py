@@ -1,34 +1,23 @@
 """One model of a whole labelled corpus (issue 47): any content in any style.
 
-Bandai dataset-2 (``bandai_dataset2``, takes 001-012; ``--contents``,
-``--styles``).  Per training seed, ``FactoredCRBM`` (the defaults;
-``--n-iter``, ``--model``) on takes 001-010 of every cell but the held-out
-ones (content ``i`` in style ``i`` modulo the styles: one per content,
-every content and style still seen), content and style as two label
-factors (``--factors 1``: one label ``content/style``, nothing held out).
-Our judge: a ``metrics.StyleJudge`` per factor on the 2-s windows of the
-preprocessed takes 001-010 of every cell; its accuracy on the windows of
-the real takes 011-012 stands beside every figure.
-
-- cells: 4 sequences of 600 frames per cell from a real normal walk; of
-  frames 300-599 the windows judged the cell's content and style,
-  sequences alive (``metrics.liveliness`` against the cell's real cycle at
-  least 0.5), divergence, jitter, blow-ups (``corpora.py``'s statistics);
-  raise-ups: the action (the range of the cell's most-moving angles over
-  frames 0-299 at least half the real takes'), then rest (frames 300-599
-  at most half);
-- switches of content and of style at frame 300 (one of each per content):
-  a window starting within 60 frames judged the new label (*in time*), and
-  the windows from frame 360 (*held*); frames per second of one sequence
-  with switching labels, one thread;
-- recognition: ``predict`` on the first ``--recognise-frames`` of every
-  take 011-012, its wall and CPU seconds;
-- likelihood per frame of takes 011-012 (frames with both models' past),
-  beside a ``ConditionalRBM`` (``--baseline``) per content;
-- the fit's seconds and the peak memory it added.
-
-Means over seeds with 95% bootstrap intervals; the JSON keeps every run.
-Run from the repository root (fits are cached)::
+Bandai dataset-2, takes 001-012 (``--contents``, ``--styles``).  Per
+training seed, ``FactoredCRBM`` (``--n-iter``, ``--model``) on takes
+001-010 of every cell but a Latin square held out (content ``i`` in style
+``i`` modulo the styles), content and style as two label factors
+(``--factors 1``: one label ``content/style``, none held out).  Our judge,
+a ``metrics.StyleJudge`` per factor on 2-s windows of the preprocessed
+takes 001-010 of every cell, has its accuracy on the real takes 011-012
+beside every figure.  Cells: 4 sequences of 600 frames from a normal walk,
+frames 300-599: windows judged the cell's content and style, sequences
+alive (liveliness against the cell's cycle >= 0.5) and ``corpora.py``'s
+statistics; raise-ups: the range of the cell's moving angles at least half
+the real takes' over frames 0-299 (action) and at most half over 300-599
+(rest).  Switches of content and style at frame 300: a window starting
+within 60 frames judged the new label, and the windows after.  Takes
+011-012: ``predict`` (``--recognise-frames``), log-likelihood per frame
+beside a ``ConditionalRBM`` per content (``--baseline``).  The fit's time
+and added peak memory; frames/s of one sequence, labels switching.  Means
+over seeds [95% bootstrap interval]; fits are cached::
 
     python benchmarks/corpus.py
     python benchmarks/corpus.py --contents walk run --styles normal elderly \\
@@ -300,7 +289,11 @@ def one_seed(corpus, judge, seed, args):
     with threadpool_limits(1):
         for cell in [(c, s) for c in args.contents for s in args.styles]:
             run["cells"]["/".join(cell)] = judge_cell(corpus, judge, model, cell, seed)
-            print(f"  seed {seed} {cell}: {run['cells']['/'.join(cell)]}", flush=True)
+            shown = {k: np.mean(v) for k, v in run["cells"]["/".join(cell)].items()}
+            shown = ", ".join(
+                f"{k} {shown[k]:.2f}" for k in PERCENT + NUMBERS if k in shown
+            )
+            print(f"  seed {seed} {'/'.join(cell)}: {shown}", flush=True)
         run["switches"] = switches(
             corpus, judge, model, args.contents, args.styles, seed
         )
