@@ -73,10 +73,14 @@ def test_labels_of_any_kind_and_label_weights():
     codes = np.where(styles == "high", 7, 3)
     model = small_model(n_iter=2).fit(X, codes, sequence_ids=ids)
     assert_array_equal(model.classes_, [3, 7])
+    # label weights are mappings: a 2-D y is one column per label factor
     weights = np.stack([styles == "high", styles == "low"], axis=1).astype(float)
-    model = small_model(n_iter=2).fit(X, weights, sequence_ids=ids)
-    assert_array_equal(model.classes_, [0, 1])
-    assert model.sample(5, style=1, n_gibbs=2).shape == (5, 6)
+    with pytest.raises(ValueError, match=r"2 label factors.*\{label: weight\}"):
+        small_model(n_iter=2).fit(X, weights, sequence_ids=ids)
+    blends = [dict(zip(["high", "low"], row, strict=True)) for row in weights]
+    model = small_model(n_iter=2).fit(X, blends, sequence_ids=ids)
+    assert_array_equal(model.classes_, ["high", "low"])
+    assert model.sample(5, style="low", n_gibbs=2).shape == (5, 6)
 
 
 def exact_log_likelihood(model, X, ids, weights):

@@ -62,7 +62,10 @@ def read_bvh_folder(
           file's sequence name, whose first group (or, without groups, the
           whole match) is the label, e.g. ``re.compile(r"walk_([a-z]+)_")``;
         - a callable: called with each file's :class:`~pathlib.Path`, it
-          returns the label.
+          returns the label;
+        - a list of these: several labels of every file (label factors,
+          such as ``["content", "style"]``), for the style models'
+          ``fit(X, y)`` with one column of ``y`` per factor.
 
         ``None`` reads no labels.
     label_names : sequence of str or path-like, default=None
@@ -78,7 +81,8 @@ def read_bvh_folder(
         be of one kind (all names, all integers, all booleans or all
         floats): ``true``, ``1`` and ``1.0`` are one value to Python and
         would merge into one class, so a mix is refused.  NaN is never a
-        label.
+        label.  With a list of ``labels``: None, or a list with one entry
+        (None or as above) per label.
 
     Returns
     -------
@@ -87,13 +91,17 @@ def read_bvh_folder(
             Raw channels of all files, one after the other.
         sequence_ids : ndarray of shape (n_frames,)
             Index into ``sequence_names`` of every frame.
-        target : ndarray of shape (n_frames,)
+        target : ndarray of shape (n_frames,) or (n_frames, n_labels)
             Only with ``labels``: the code of every frame's label, an index
-            into ``target_names``.
-        target_names : ndarray of str
+            into ``target_names``.  With a list of labels, every frame's
+            label names instead, one column per label (``["run",
+            "elderly"]``), ready to be the ``y`` of a style model.
+        target_names : ndarray of str or list of ndarray of str
             Only with ``labels``: the label names, as text (labels that are
             numbers too), ready to use as class labels:
-            ``target_names[target]`` is the label of every frame.
+            ``target_names[target]`` is the label of every frame.  With a
+            list of labels, a list with each label's names that some file
+            has, in the order of their codes.
         sequence_names : ndarray of str
             One name per file, e.g. ``"walk_01"`` or ``"subject1/walk_01"``.
         feature_names : ndarray of str
@@ -122,7 +130,8 @@ def read_bvh_folder(
         cannot be moved into the joint most files travel with, a file's
         label is missing, not a finite value or not among ``label_names``
         (a str ``labels`` is a JSON key; a label from the file names needs
-        a compiled pattern).  The message names the file.
+        a compiled pattern).  The message names the file.  With a list
+        of labels, if ``label_names`` is not None or a list as long.
     TypeError
         If a label is not a single name or number, or the labels mix kinds
         (``true``, ``1`` and ``1.0`` would merge into one class).
@@ -153,6 +162,19 @@ def read_bvh_folder(
     ...                         labels=re.compile(r"walk_([0-9])"))
     >>> walks.target.tolist(), list(walks.target_names)
     ([0, 0, 1, 1], ['0', '1'])
+
+    Several labels, each file's from a JSON file beside it:
+
+    >>> import json
+    >>> for seed, style in ((0, "slow"), (1, "brisk")):
+    ...     labels = {"content": "walk", "style": style}
+    ...     _ = (folder / f"walk_{seed}.json").write_text(json.dumps(labels))
+    >>> walks = read_bvh_folder(folder, frame_rate=30.0,
+    ...                         labels=["content", "style"])
+    >>> walks.target.tolist()
+    [['walk', 'slow'], ['walk', 'slow'], ['walk', 'brisk'], ['walk', 'brisk']]
+    >>> [list(names) for names in walks.target_names]
+    [['walk'], ['brisk', 'slow']]
     """
     folder, paths = _matching_files(folder, pattern)
     sequences = []
@@ -284,9 +306,37 @@ def _with_labels(bunch, folder, paths, labels, label_names):
                 "label_names names the labels that labels= reads; pass labels= too."
             )
         return bunch
+    if isinstance(labels, list | tuple):
+        return _with_several_labels(bunch, folder, paths, labels, label_names)
     codes, names = file_labels(folder, paths, labels, label_names)
     bunch.target = codes[bunch.sequence_ids]
     bunch.target_names = names
+    return bunch
+
+
+def _with_several_labels(bunch, folder, paths, labels, label_names):
+    """``bunch`` with every frame's label names of each of ``labels`` (a
+    column each) and each label's names that the files have."""
+    if not labels:
+        raise ValueError("labels is an empty list: give at least one label.")
+    if label_names is None:
+        label_names = [None] * len(labels)
+    if not isinstance(label_names, list | tuple) or len(label_names) != len(labels):
+        raise ValueError(
+            f"With {len(labels)} labels, label_names must be None or a list of "
+            f"{len(labels)} entries, one per label (each None, a names file or a "
+            f"list of names); got {label_names!r}."
+        )
+    columns, present = [], []
+    for key, names_of_key in zip(labels, label_names, strict=True):
+        codes, names = file_labels(folder, paths, key, names_of_key)
+        columns.append(names[codes[bunch.sequence_ids]])
+        present.append(names[np.unique(codes)])
+    target = np.empty((len(bunch.sequence_ids), len(labels)), dtype=object)
+    for j, column in enumerate(columns):
+        target[:, j] = column
+    bunch.target = target
+    bunch.target_names = present
     return bunch
 
 

@@ -11,6 +11,7 @@ from sklearn.utils.validation import _is_fitted, _num_samples, check_is_fitted
 
 from .._engines._online import WHOLE_STACK, Observed, collect_fills, run_online
 from ..models._crbm import ConditionalRBM
+from ..models._label_factors import as_entries
 from ..utils._array_api import array_ops, array_random, copy_array
 from ..utils._fitting import unfitted_on_error
 from ..utils._parallel import BLOCK_SEQUENCES, map_sequence_blocks
@@ -219,10 +220,11 @@ class CRBMImputer(BaseMotionImputer):
             Training sequences, stacked, each contiguous and in time order.
             The model learns from complete frames only: a frame with a
             missing value is left out and splits its sequence in two.
-        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
-            The style of every frame, for a model of styles
-            (:class:`~sklearn_crbm.FactoredCRBM`), which needs it; ignored
-            by a model without styles.
+        y : array-like of shape (n_frames,) or (n_frames, n_outputs), default=None
+            The labels of every frame, for a model of styles
+            (:class:`~sklearn_crbm.FactoredCRBM`), which needs them (one
+            column per label factor, as the model's ``fit`` takes them);
+            ignored by a model without styles.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
         context : array-like of shape (n_frames, n_context), default=None
@@ -285,11 +287,14 @@ class CRBMImputer(BaseMotionImputer):
             it); frame ``t`` is filled given its own context.
         style : label or array-like of shape (n_frames,) or (n_frames, \
 n_classes), default=None
-            A model of styles only: the style of every frame.  None infers
-            it on-line: the particles of each draw carry one style each
-            (``n_particles`` at least the number of styles covers them all),
-            and resampling by how well each explains the observed channels
-            keeps the particles of the styles that do.
+            A model of styles only: the style of every frame (for a model
+            of several label factors, a row of labels for every frame or
+            one per frame).  None infers it on-line: the particles of each
+            draw carry one style each (one combination of a label of each
+            factor; ``n_particles`` at least the number of styles, or of
+            combinations, covers them all), and resampling by how well each
+            explains the observed channels keeps the particles of the
+            styles that do.
 
         Returns
         -------
@@ -490,11 +495,12 @@ def _complete_styles(estimator, y, rows, n_frames, context):
                 "the style of every training frame (or a real-valued context=)."
             )
         return None
-    y = np.asarray(y)
+    y = as_entries(y)
     if y.ndim == 0 or len(y) != n_frames:
         raise ValueError(
             f"y must hold one style label per frame of X ({n_frames}); got an "
-            f"array of shape {y.shape}."
+            f"array of shape {y.shape} (several label factors: one row of labels "
+            "per frame)."
         )
     return y[rows]
 

@@ -291,7 +291,8 @@ def lifeless_message(
 def _styles_asked(labels, label_names):
     """``" ('fast')"``, or ``" ('fast' 0.5, 'slow' 0.5)"`` for a blend: the
     styles of the label weights of the frames judged, with their weights;
-    "" without names."""
+    ``" ('run', 'elderly')"`` for the whole weight of labels of several
+    factors; "" without names."""
     if label_names is None:
         return ""
     weights = to_numpy(labels)[-LIVELINESS_FRAMES:].mean(axis=0)
@@ -299,8 +300,8 @@ def _styles_asked(labels, label_names):
     asked = asked[np.argsort(-weights[asked], kind="stable")]
     names = [np.asarray(label_names)[k] for k in asked]
     names = [repr(n.item() if isinstance(n, np.generic) else n) for n in names]
-    if len(asked) == 1:
-        return f" ({names[0]})"
+    if np.allclose(weights[asked], 1):
+        return f" ({', '.join(names)})"
     weighted = (f"{n} {weights[k]:.2f}" for n, k in zip(names, asked, strict=True))
     return " (" + ", ".join(weighted) + ")"
 

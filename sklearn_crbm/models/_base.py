@@ -223,8 +223,8 @@ class BaseCRBM(
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
-            The style of every frame, for the style models (see :meth:`fit`);
+        y : array-like of shape (n_frames,) or (n_frames, n_outputs), default=None
+            The labels of every frame, for the style models (see :meth:`fit`);
             ignored by the others.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
@@ -325,7 +325,10 @@ class BaseCRBM(
         style : label or array-like of shape (n_frames,) or (n_frames, \
 n_classes), default=None
             A style model's labels (one for every frame, one per frame, or
-            label weights per frame) in place of ``context``.
+            label weights per frame) in place of ``context``.  For a model
+            of several label factors: one row of labels, one per factor,
+            for every frame, or one row per frame ``(n_frames,
+            n_outputs)``, as ``y`` of :meth:`fit`.
 
         Returns
         -------
@@ -435,9 +438,17 @@ n_classes), default=None
         return array_ops(X).astype(log_likelihood, X.dtype)
 
     def _log_likelihood(
-        self, X, sequences, method="auto", reverse=False, rng=None, context=None
+        self,
+        X,
+        sequences,
+        method="auto",
+        reverse=False,
+        rng=None,
+        context=None,
+        frames=None,
     ):
-        """:class:`~sklearn_crbm._engines._likelihood.LogLikelihood` of every frame."""
+        """:class:`~sklearn_crbm._engines._likelihood.LogLikelihood` of every frame
+        (of ``frames`` only, in their order, for a model of one layer)."""
         layers = self._fitted_layers()
         n_steps, n_chains = self._ais_settings()
         rng = rng_from(self.random_state) if rng is None else rng
@@ -445,13 +456,17 @@ n_classes), default=None
         if len(layers) == 1:
             return frame_log_likelihood(
                 X,
-                sequence_frame_rbms(layers[0], X, sequences, context=context),
+                sequence_frame_rbms(
+                    layers[0], X, sequences, frames=frames, context=context
+                ),
                 method=method,
                 n_steps=n_steps,
                 n_chains=n_chains,
                 reverse=reverse,
                 rng=rng,
             )
+        if frames is not None:
+            raise NotImplementedError("frames= with a stack of layers")
         ops = array_ops(X)
         bounds = [
             stack_log_likelihood_bound(
@@ -569,8 +584,10 @@ n_classes), default=None
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
-            A style model's labels of every frame (None: unknown, see
+        y : array-like of shape (n_frames,) or (n_frames, n_outputs), default=None
+            A style model's labels of every frame, as ``y`` of :meth:`fit`
+            (a model of one factor also takes label weights, shape
+            ``(n_frames, n_classes)``; None: unknown, see
             :meth:`score_samples`); ignored by the other models.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.

@@ -22,6 +22,8 @@ class ContextMixin:
       (None: ``y`` is ignored);
     - ``_style_context(style, n_frames, like)``: every frame's context from
       ``style`` (a model of styles only);
+    - ``_labels_rows(y, n_frames, like)``: every generated frame's context
+      from ``sample``'s ``y`` (a model of labels only);
     - ``_inference_context(X, sequences, context)``: the context of frames
       given none (a style model infers it);
     - ``_online_context(X, context)``: what on-line fill-in conditions on;
@@ -57,6 +59,14 @@ class ContextMixin:
         raise ValueError(
             f"{type(self).__name__} has no styles: give context= instead of "
             "style=, or use a style model such as FactoredCRBM or LabelledCRBM."
+        )
+
+    def _labels_rows(self, y, n_frames, like):
+        """Every generated frame's context from ``sample``'s ``y`` (a model of
+        labels only)."""
+        raise ValueError(
+            f"{type(self).__name__} has no labels: give context= instead of y=, "
+            "or use a style model such as FactoredCRBM or LabelledCRBM."
         )
 
     def _inference_context(self, X, sequences, context):
@@ -131,11 +141,22 @@ class ContextMixin:
             "not both."
         )
 
-    def _method_context(self, context, style, n_frames, like, *, one_row=False):
-        """The context a method is given, as ``context`` or as ``style`` (checked).
+    def _method_context(self, context, style, n_frames, like, *, one_row=False, y=None):
+        """The context a method is given, as ``context``, ``style`` or (``sample``)
+        ``y`` (checked).
 
         With ``one_row`` (``sample``) a single row stands for every frame.
         """
+        if y is not None:
+            if style is not None:
+                raise ValueError(
+                    f"{type(self).__name__} got both y= and style=: give the "
+                    "labels once (y= takes a row of labels of every factor, "
+                    "style= the label of a model of one)."
+                )
+            if context is not None:
+                raise self._both_error("y=")
+            return self._labels_rows(y, n_frames, like)
         if style is not None:
             if context is not None:
                 raise self._both_error("style=")

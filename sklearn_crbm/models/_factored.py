@@ -8,20 +8,29 @@ from sklearn.utils._param_validation import Interval
 from ..layers._factored import FactoredLayer
 from ..utils._array_api import to_numpy
 from ._base import FittedParameter
+from ._label_factors import blocks
 from ._style import BaseStyleModel
 
 __all__ = ["FactoredCRBM"]
 
 
-def balanced_frames(frames, label_weights):
+def balanced_frames(frames, label_weights, blocks=None):
     """``frames`` with each style's frames repeated to about the most frequent's count.
 
-    A frame's style is its largest label weight; a style with ``n`` frames is
-    repeated ``round(n_max / n)`` times (at least once), as the released code
-    copies the takes of the less frequent styles.  Copies stay next to their
-    frame, so the frames remain in time order.
+    A frame's style is its largest label weight (with several label factors,
+    whose weights fill the ``blocks`` of the columns, its combination of
+    each factor's largest); a style with ``n`` frames is repeated ``round(n_max
+    / n)`` times (at least once), as the released code copies the takes of
+    the less frequent styles.  Copies stay next to their frame, so the
+    frames remain in time order.
     """
-    styles = np.argmax(to_numpy(label_weights)[frames], axis=1)
+    weights = to_numpy(label_weights)[frames]
+    if blocks is None:
+        styles = np.argmax(weights, axis=1)
+    else:
+        codes = [np.argmax(weights[:, block], axis=1) for block in blocks]
+        sizes = [block.stop - block.start for block in blocks]
+        styles = np.ravel_multi_index(codes, sizes)
     counts = np.bincount(styles)
     copies = np.zeros(len(counts), dtype=np.intp)
     present = counts > 0
@@ -48,6 +57,14 @@ class FactoredCRBM(BaseStyleModel):
     all sequences, ``sequence_ids`` marks which frames belong together, and
     ``y`` gives every frame's style.  Standardise ``X`` first (the visible
     units are Gaussian with unit variance).
+
+    Several label factors, such as the content of the motion and its style,
+    are the columns of a 2-D ``y``, as scikit-learn's multi-output
+    classifiers take them: each factor's label is a one-hot block of the
+    labels the style features come from, so that the factors' gates add,
+    and a combination never seen in training (an elderly run, from elderly
+    walks and other styles' runs) can be asked for.  A blend of a factor's
+    labels is a mapping ``{label: weight}`` in place of the label.
 
     Parameters
     ----------
@@ -108,9 +125,9 @@ class FactoredCRBM(BaseStyleModel):
         Number of epochs.
     n_gibbs : int, default=100
         Alternating Gibbs iterations per generated frame in :meth:`sample`.
-    priors : array-like of shape (n_classes,), default=None
-        Prior probabilities of the styles in :meth:`predict_proba`; None:
-        equal.
+    priors : array-like of shape (n_classes,) or list of array-like, default=None
+        Prior probabilities of the styles in :meth:`predict_proba`; with
+        several label factors, a list of each factor's; None: equal.
     ais_steps : int, default=50
         Intermediate distributions of the annealed importance sampling of
         :meth:`score` and :meth:`score_samples`.
@@ -151,12 +168,15 @@ class FactoredCRBM(BaseStyleModel):
 
     Attributes
     ----------
-    classes_ : ndarray of shape (n_classes,)
+    classes_ : ndarray of shape (n_classes,) or list of ndarray
         The styles, in the order of the columns of label weights (fitted on
-        labels only).
+        labels only); with several label factors, a list of each factor's
+        labels, whose blocks of columns follow one another.
+    n_outputs_ : int
+        Number of label factors (columns of ``y``; fitted on labels only).
     n_context_ : int
         Columns of the context: the number of styles for a model fitted on
-        labels.
+        labels (with several factors, of all their labels).
     context_mean_ : ndarray of shape (n_context,)
         Mean of each column of a real-valued context in ``fit``, which the
         model subtracts from every context it is given (absent when fitted
@@ -222,6 +242,20 @@ class FactoredCRBM(BaseStyleModel):
     (40, 6)
     >>> weights = np.linspace([1, 0], [0, 1], 20)  # from fast to slow
     >>> model.sample(20, style=weights, n_gibbs=5).shape
+    (20, 6)
+
+    Two label factors, content and style, one column each:
+
+    >>> content = np.where(ids % 2 == 0, "walk", "run")
+    >>> y = np.stack([content, styles], axis=1)
+    >>> model = model.fit(X, y, sequence_ids=ids)
+    >>> model.classes_
+    [array(['run', 'walk'], dtype='<U4'), array(['fast', 'slow'], dtype='<U4')]
+    >>> model.predict(X[:60]).shape
+    (60, 2)
+    >>> [proba.shape for proba in model.predict_proba(X[:60])]
+    [(60, 2), (60, 2)]
+    >>> model.sample(20, y=("run", {"fast": 0.5, "slow": 0.5}), n_gibbs=5).shape
     (20, 6)
     """
 
@@ -330,7 +364,7 @@ class FactoredCRBM(BaseStyleModel):
 
     def _train(self, X, frames, n_epochs, n_averaged=0, context=None):
         if self.balance_styles and self._labelled:
-            frames = balanced_frames(frames, context)
+            frames = balanced_frames(frames, context, blocks(self._factor_classes))
         super()._train(X, frames, n_epochs, n_averaged, context)
 
     def _new_layer(self, n_features, n_context, dtype):

@@ -21,7 +21,9 @@ class LabelledCRBM(BaseStyleModel):
     x_past + L_h y``.  The labels shift the biases but do not change how
     the units interact (no gating): the baseline Taylor & Hinton (2009)
     compare :class:`FactoredCRBM` with.  It generates, scores, fills in
-    and names styles as :class:`FactoredCRBM` does.
+    and names styles as :class:`FactoredCRBM` does, of one label factor or
+    several (the columns of a 2-D ``y``, such as content and style: each a
+    one-hot block of the labels, whose shifts of the biases add).
 
     Parameters
     ----------
@@ -44,8 +46,9 @@ class LabelledCRBM(BaseStyleModel):
     n_iter : int, default=1000
     n_gibbs : int, default=30
         Alternating Gibbs iterations per generated frame in :meth:`sample`.
-    priors : array-like of shape (n_classes,), default=None
-        Prior probabilities of the styles in :meth:`predict_proba`.
+    priors : array-like of shape (n_classes,) or list of array-like, default=None
+        Prior probabilities of the styles in :meth:`predict_proba`; with
+        several label factors, a list of each factor's.
     ais_steps : int, default=50
     ais_chains : int, default=2
     early_stopping : bool, default=False
@@ -75,8 +78,11 @@ class LabelledCRBM(BaseStyleModel):
 
     Attributes
     ----------
-    classes_ : ndarray of shape (n_classes,)
-        The styles, in the order of the columns of label weights.
+    classes_ : ndarray of shape (n_classes,) or list of ndarray
+        The styles, in the order of the columns of label weights; with
+        several label factors, a list of each factor's labels.
+    n_outputs_ : int
+        Number of label factors (columns of ``y``).
     components_ : ndarray of shape (n_components, n_features)
     intercept_hidden_ : ndarray of shape (n_components,)
     intercept_visible_ : ndarray of shape (n_features,)
@@ -129,6 +135,16 @@ class LabelledCRBM(BaseStyleModel):
     (16, 2)
     >>> model.sample(20, style="fast", n_sequences=2).shape
     (40, 6)
+
+    Content and style, switching the content on-line after 10 frames:
+
+    >>> y = np.stack([np.where(ids % 2 == 0, "walk", "run"), styles], axis=1)
+    >>> model = model.fit(X, y, sequence_ids=ids)
+    >>> model.n_outputs_, model.label_to_hidden_.shape
+    (2, (16, 4))
+    >>> rows = [("walk", "fast")] * 10 + [("run", "fast")] * 10
+    >>> model.sample(20, y=rows).shape
+    (20, 6)
     """
 
     _parameter_constraints: dict = {

@@ -91,12 +91,19 @@ class BaseLayerModel(BaseCRBM):
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
-            The style of every frame, for the style models
+        y : array-like of shape (n_frames,) or (n_frames, n_outputs), default=None
+            The labels of every frame, for the style models
             (:class:`~sklearn_crbm.FactoredCRBM`,
-            :class:`~sklearn_crbm.LabelledCRBM`: a label per frame, or label
-            weights per frame), which turn it into their context; ignored by
-            :class:`~sklearn_crbm.ConditionalRBM`.
+            :class:`~sklearn_crbm.LabelledCRBM`), which turn them into their
+            context; ignored by :class:`~sklearn_crbm.ConditionalRBM`.  One
+            label per frame (one label factor, such as a style), or one
+            column per label factor (such as content and style), as
+            scikit-learn's multi-output classifiers take them; each
+            factor's label is a one-hot block of the context.  In place of
+            a label, a factor's entry may be a blend of its labels, a
+            mapping ``{label: weight}`` of weights that sum to 1.  A 2-D
+            ``y`` of floats is refused: label weights are written as such
+            mappings.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
         context : array-like of shape (n_frames, n_context), default=None
@@ -145,8 +152,8 @@ class BaseLayerModel(BaseCRBM):
         ----------
         X : array-like of shape (n_frames, n_features)
             All sequences stacked, each contiguous and in time order.
-        y : array-like of shape (n_frames,) or (n_frames, n_classes), default=None
-            The style of every frame, as in :meth:`fit`.
+        y : array-like of shape (n_frames,) or (n_frames, n_outputs), default=None
+            The labels of every frame, as in :meth:`fit`.
         sequence_ids : array-like of shape (n_frames,), default=None
             Integer sequence id of every frame; ``None`` means one sequence.
         context : array-like of shape (n_frames, n_context), default=None

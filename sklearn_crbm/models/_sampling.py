@@ -61,6 +61,7 @@ class SamplingMixin:
         n_samples,
         *,
         history=None,
+        y=None,
         context=None,
         style=None,
         n_sequences=1,
@@ -97,16 +98,27 @@ class SamplingMixin:
             sequence alike; shape ``(n_sequences, n_frames, n_features)``
             gives each sequence its own seed.  ``None`` draws windows of real
             training frames kept by :meth:`fit` (``seed_windows_``).
+        y : label, mapping or array-like, default=None
+            A model fitted on labels: the labels of the new frames, as ``y``
+            in :meth:`fit`.  One factor: a label for every frame or one per
+            frame, shape ``(n_samples,)``.  Several factors: one row of
+            labels, one per factor, for every frame (``("run",
+            "elderly")``), or one row per frame, shape ``(n_samples,
+            n_outputs)``: changing a factor's label between frames switches
+            it on-line.  In place of a label, a factor's entry may be a blend
+            of its labels, a mapping ``{label: weight}`` of weights that sum
+            to 1 (``("walk", {"elderly": 0.5, "youthful": 0.5})``).
         context : array-like of shape (n_samples, n_context) or (1, n_context), \
 default=None
             The context of every new frame (one row: the same for all),
             for every sequence; needed by a model fitted with a context.
             Changing it over the frames steers the motion (a transition).
         style : label or array-like of shape (n_samples, n_classes), default=None
-            A style model's labels in place of ``context``: a label seen in
-            :meth:`fit`, or non-negative label weights that sum to 1 in
-            every frame (a blend; a transition when they change over the
-            frames).
+            The labels of a model of one label factor, in place of ``y``: a
+            label seen in :meth:`fit`, one per frame, or non-negative label
+            weights that sum to 1 in every frame (a blend; a transition when
+            they change over the frames).  For a model of several factors,
+            as ``y``.
         n_sequences : int, default=1
             Number of sequences to generate; with a 3-D ``history`` it is
             taken from the history.
@@ -173,7 +185,9 @@ default=None
                 f"hidden_noise must be a non-negative number, got {hidden_noise!r}."
             )
         like = self.seed_windows_
-        context = self._method_context(context, style, n_samples, like, one_row=True)
+        context = self._method_context(
+            context, style, n_samples, like, one_row=True, y=y
+        )
         if context is None and self.n_context_:
             raise self._missing_context_error()
         labels = self._liveliness_labels(context)  # before it is broadcast
@@ -211,6 +225,10 @@ default=None
         training sequences alike); models fitted on labels return them."""
         return None
 
+    def _context_names(self):
+        """What each column of the context is called in messages (None: nothing)."""
+        return getattr(self, "classes_", None)
+
     def _check_generated(self, frames, n_frames, labels=None):
         """Warn with a :class:`GenerationWarning` about sequences that died out
         or blew up (a model fitted before ``generation_statistics_`` existed
@@ -226,7 +244,7 @@ default=None
             statistics,
             scale,
             labels,
-            getattr(self, "classes_", None),
+            self._context_names(),
         )
         if message:
             warnings.warn(message, GenerationWarning, stacklevel=_caller_level())

@@ -15,7 +15,7 @@ from ..utils._sequences import check_sequence_ids
 from ..utils._threads import batch_rows, limit_blas_threads
 from ._base import BaseCRBM
 from ._crbm import ConditionalRBM
-from ._style import _on_host
+from ._label_factors import as_entries
 
 __all__ = ["StackedCRBM"]
 
@@ -330,7 +330,7 @@ class StackedCRBM(BaseCRBM):
             context = ops.take(context, valid, axis=0)
         # labels go up to layers that take them (a style model requires them)
         takes_labels = y is not None and get_tags(layer).target_tags.required
-        y = _on_host(y)[valid] if takes_labels else None
+        y = as_entries(y)[valid] if takes_labels else None
         return ops.take(hidden, valid, axis=0), y, ids[valid], context
 
     # ------------------------------------------------------------------ fit

@@ -198,10 +198,14 @@ class MotionPipeline(Pipeline):
         random_state : int, RandomState instance or None, default=None
             Seeds the generation.
         **params : dict
-            Passed on to the model's ``sample``: ``context`` (every new
-            frame's context, for a model fitted with one), ``style``,
-            ``n_gibbs``, ``hidden_noise``, ``sample_visibles``,
-            ``n_mean_field``, ``n_jobs``.
+            Passed on to the model's ``sample``: ``y`` (a style model's
+            labels of the new frames: one row of labels of every factor,
+            such as ``("run", "elderly")``, or one row per frame, which
+            switches labels on-line; a blend of a factor's labels is a
+            mapping ``{label: weight}``), ``style`` (the labels of a model
+            of one factor), ``context`` (every new frame's context, for a
+            model fitted with one), ``n_gibbs``, ``hidden_noise``,
+            ``sample_visibles``, ``n_mean_field``, ``n_jobs``.
 
         Returns
         -------
@@ -267,8 +271,10 @@ class MotionPipeline(Pipeline):
         ----------
         X : array-like of shape (n_frames, n_raw_features)
             Real motion in raw channels, for example the training data.
-        y : array-like of shape (n_frames,)
-            The style (any label) of every frame.
+        y : array-like of shape (n_frames,) or (n_frames, n_outputs)
+            The style (any label) of every frame, or its labels of several
+            factors (a row such as ``["run", "elderly"]``), as the model's
+            ``fit`` took them.
         sequence_ids : array-like of shape (n_frames,), default=None
             Sequence id of every frame; ``None`` means one sequence.
         n_windows : int, default=50
@@ -281,7 +287,8 @@ class MotionPipeline(Pipeline):
         windows : dict
             ``{style: ndarray of shape (n_windows, width, n_features)}`` in
             the model's space, oldest frame first, the styles in order of
-            first appearance.
+            first appearance; with several factors, keyed by the tuple of a
+            row's labels (``("run", "elderly")``).
 
         Raises
         ------
@@ -289,25 +296,32 @@ class MotionPipeline(Pipeline):
             If a style has no run of ``width`` frames within one sequence.
         """
         y = np.asarray(y, dtype=object)
-        if y.shape != (len(X),):
+        if y.ndim not in (1, 2) or len(y) != len(X):
             raise ValueError(
-                f"y must hold one style per frame: {len(X)} labels, got shape "
-                f"{y.shape}."
+                f"y must hold one style per frame: {len(X)} labels (or rows of "
+                f"labels), got shape {y.shape}."
             )
+        # several label factors: a row of labels is a style
+        labels = [tuple(row) for row in y.tolist()] if y.ndim == 2 else y.tolist()
+        index = {}
+        codes = np.array(
+            [index.setdefault(label, len(index)) for label in labels], dtype=np.intp
+        )
+        styles = list(index)
         params = {} if sequence_ids is None else {"sequence_ids": sequence_ids}
         _check_routing(params)
         Z = self[:-1].transform(X, **params)
-        runs = _label_runs(sequence_ids, y)
+        runs = _label_runs(sequence_ids, codes)
         width = max(self._final_estimator.history_length, 1)
         rng = np.random.default_rng(random_state)
         windows = {}
-        for style in dict.fromkeys(y.tolist()):
+        for code, style in enumerate(styles):
             windows[style] = random_windows(
                 Z,
                 sequence_ids=runs,
                 width=width,
                 n_windows=n_windows,
-                sequences=np.unique(runs[y == style]),
+                sequences=np.unique(runs[codes == code]),
                 random_state=rng,
             )
         return windows

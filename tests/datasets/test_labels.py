@@ -251,6 +251,47 @@ def test_labels_errors(styles_folder, tmp_path):
         read_bvh_folder(tmp_path, labels=lambda p: 1 if p.stem == "walk_a" else "b")
 
 
+def test_several_labels_are_columns_of_names(data_home):
+    """labels=["content", "style"]: a style model's 2-D y, as the user names
+    the labels, only those present."""
+    corpus = data_home / "bandai_dataset2"
+    takes = read_bvh_folder(
+        corpus, pattern="*_r*_e*_001.bvh", labels=["content", "style"]
+    )
+    assert takes.target.shape == (len(takes.data), 2)
+    contents, styles = takes.target_names
+    assert list(contents) == [
+        "run",
+        "raise-up-both-hands",
+        "raise-up-left-hand",
+        "raise-up-right-hand",
+    ]
+    assert list(styles) == ["elderly", "exhausted"]
+    for k, name in enumerate(takes.sequence_names):
+        _, content, style, _ = name.split("_")
+        assert takes.target[takes.sequence_ids == k].tolist()[0] == [content, style]
+    one = read_bvh_folder(corpus, pattern="*_run_e*_001.bvh", labels=["style"])
+    assert one.target.shape == (len(one.data), 1)
+
+
+def test_several_labels_errors(tmp_path):
+    walker = make_walker(n_sequences=1, n_frames=4, random_state=0)
+    write_bvh(tmp_path / "walk_a.bvh", walker.data, walker.skeleton, 30.0)
+    (tmp_path / "walk_a.json").write_text('{"content": 1, "style": 0}')
+    with pytest.raises(ValueError, match="label_names must be None or a list of 2"):
+        read_bvh_folder(tmp_path, labels=["content", "style"], label_names=["a"])
+    with pytest.raises(ValueError, match="has label 1, but there are 1 label names"):
+        read_bvh_folder(
+            tmp_path, labels=["content", "style"], label_names=[["walk"], None]
+        )
+    with pytest.raises(ValueError, match="empty list"):
+        read_bvh_folder(tmp_path, labels=[])
+    named = read_bvh_folder(
+        tmp_path, labels=["content", "style"], label_names=[["walk", "run"], None]
+    )
+    assert named.target.tolist() == [["run", "0"]] * 4
+
+
 def test_load_bandai_walks(bandai, styles_folder):
     assert bandai.data.shape == (11337, 132)
     assert list(bandai.target_names) == STYLES

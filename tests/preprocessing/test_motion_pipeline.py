@@ -9,7 +9,7 @@ from numpy.testing import assert_allclose, assert_array_equal
 from sklearn.base import BaseEstimator, TransformerMixin, clone
 from sklearn.model_selection import GridSearchCV, GroupKFold
 
-from sklearn_crbm import ConditionalRBM
+from sklearn_crbm import ConditionalRBM, LabelledCRBM
 from sklearn_crbm.datasets import make_walker, read_amc, read_bvh
 from sklearn_crbm.metrics import forward_speed
 from sklearn_crbm.preprocessing import (
@@ -185,3 +185,23 @@ def test_sample_passes_keywords_through_to_the_models_sample(walker):
     assert not np.allclose(walk, jog)
     with pytest.raises(TypeError, match="style"):
         pipe.sample(4)
+
+
+def test_a_model_of_several_label_factors_samples_any_row(walker):
+    rows = np.array(
+        [("walk", "slow"), ("jog", "slow"), ("walk", "brisk"), ("jog", "brisk")]
+    )
+    y = rows[walker.sequence_ids]
+    model = LabelledCRBM(8, order=2, n_iter=3, n_gibbs=3, random_state=0)
+    pipe = make_motion_pipeline(walker.skeleton, model)
+    pipe.fit(walker.data, y, sequence_ids=walker.sequence_ids)
+    frames = pipe.sample(4, n_sequences=2, y=("jog", "slow"), random_state=0)
+    assert frames.shape == (8, walker.data.shape[1])
+    switched = pipe.sample(4, y=[("walk", "slow")] * 2 + [("jog", "brisk")] * 2)
+    assert switched.shape == (4, walker.data.shape[1])
+    windows = pipe.style_windows(
+        walker.data, y, sequence_ids=walker.sequence_ids, n_windows=3, random_state=0
+    )
+    assert list(windows) == [tuple(row) for row in rows]
+    seeded = pipe.sample(4, history=windows[("jog", "brisk")], y=("jog", "brisk"))
+    assert seeded.shape == (12, walker.data.shape[1])

@@ -986,6 +986,11 @@ def test_bad_history(case, ctx):
 # kind -> (the bad styles of n frames, (exception, message) where they are the
 # y of a first fit, or None where they are valid there, (exception, message)
 # anywhere else); {name} is the argument's name, y or style.
+# A 2-D y of fit holds label factors, one a column: label weights are refused.
+WEIGHTS_IN_FIT = (
+    ValueError,
+    r"holds the labels of \d label factors.*{{label: weight}}",
+)
 BAD_STYLES = {
     "unseen label": (
         lambda n: np.full(n, "medium"),
@@ -1022,27 +1027,31 @@ BAD_STYLES = {
     ),
     "weights not summing to 1": (
         lambda n: np.full((n, 2), 0.4),
-        (ValueError, "y weights must sum to 1 in every frame; a frame's sum to 0.8"),
+        WEIGHTS_IN_FIT,
         (ValueError, "{name} weights must sum to 1 in every frame; a frame's sum"),
     ),
     "negative weights": (
         lambda n: np.tile([-0.5, 1.5], (n, 1)),
-        (ValueError, "y weights must be non-negative"),
+        WEIGHTS_IN_FIT,
         (ValueError, "{name} weights must be non-negative"),
     ),
     "infinite weights": (
         lambda n: np.tile([np.inf, 0.0], (n, 1)),
-        (ValueError, "y weights contain NaN or infinity"),
+        WEIGHTS_IN_FIT,
         (ValueError, "{name} weights contain NaN or infinity"),
     ),
     "weights of 3 styles": (
         lambda n: np.full((n, 3), 1 / 3),
-        None,
+        WEIGHTS_IN_FIT,
         (ValueError, r"{name} weights must have shape \(n_frames, 2\)"),
     ),
     "text weights": (
         lambda n: np.full((n, 2), "a"),
-        (ValueError, r"y must hold one style label per frame .*shape \(60, 2\)"),
+        (  # two label factors, of one class each (a refit: one factor)
+            ValueError,
+            r"y\[:, 0\] holds one class|y must be one style label per frame.*"
+            r"shape \(60, 2\)",
+        ),
         (TypeError, "{name} weights must be numbers"),
     ),
     "3-D": (
