@@ -12,7 +12,8 @@ frames 300-599: windows judged the cell's content and style, sequences
 alive (liveliness against the cell's cycle >= 0.5) and ``corpora.py``'s
 statistics; raise-ups: the range of the cell's moving angles at least half
 the real takes' over frames 0-299 (action) and at most half over 300-599
-(rest).  Switches of content and style at frame 300: a window starting
+(rest).  Per content, switches at frame 300 of its content (into a
+held-out cell) and of its style (into a trained one): a window starting
 within 60 frames judged the new label, and the windows after.  Takes
 011-012: ``predict`` (``--recognise-frames``), log-likelihood per frame
 beside a ``ConditionalRBM`` per content (``--baseline``).  The fit's time
