@@ -557,4 +557,5 @@ class BaseStyleModel(BaseLayerModel):
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
         tags.target_tags.required = True
+        tags.target_tags.multi_output = True  # several label factors
         return tags
