@@ -132,6 +132,7 @@ class Judge:
         judged; ``ids`` None: sequences of ``N_FRAMES``."""
         if ids is None:
             ids = np.repeat(np.arange(len(Z) // N_FRAMES), N_FRAMES)
+        Z = np.clip(np.nan_to_num(Z), -1e3, 1e3)  # what is left of a blow-up
         content, style = (judge.verdict(Z, sequence_ids=ids) for judge in self.judges)
         return Bunch(
             sequence_ids=content.sequence_ids,
