@@ -174,7 +174,8 @@ def judge_cell(corpus, judge, model, cell, seed):
     judged = windows.starts >= SWITCH
     run["content"] = float(np.mean(windows.content[judged] == cell[0]))
     run["style"] = float(np.mean(windows.style[judged] == cell[1]))
-    run["alive"] = float(np.mean(np.asarray(run["liveliness"]) >= 0.5))
+    kept = np.asarray(run["blown"]) == 0  # a blow-up is neither alive nor acts
+    run["alive"] = float(np.mean((np.asarray(run["liveliness"]) >= 0.5) & kept))
     if cell[0] in ONE_SHOT:
         moving = real.unscaled(np.clip(np.nan_to_num(Z), -1e3, 1e3))[:, real.channels]
         halves = moving.reshape(N_SEQUENCES, 2, N_FRAMES // 2, -1)
@@ -186,7 +187,7 @@ def judge_cell(corpus, judge, model, cell, seed):
             ]
         )
         ranges = np.ptp(halves, axis=2).mean(axis=-1) / real_range
-        run["action"] = float(np.mean(ranges[:, 0] >= 0.5))
+        run["action"] = float(np.mean((ranges[:, 0] >= 0.5) & kept))
         run["rest"] = float(np.mean(ranges[:, 1] <= 0.5))
     return run
 
