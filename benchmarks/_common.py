@@ -9,6 +9,7 @@ API only.
 
 import argparse
 import ast
+import ctypes
 import hashlib
 import json
 import os
@@ -316,12 +317,14 @@ def _code(path):
     return ast.dump(tree)
 
 
-def cached_fit(model, X, sequence_ids, **fit_params):
+def cached_fit(model, X, sequence_ids, *, memory=False, **fit_params):
     """``(fitted model, fit seconds)``, read from the cache when it is there.
 
     The key is the model's class and parameters, the data (with the arrays
     in ``fit_params``, such as ``context``) and the package's code
-    (:func:`model_code_digest`), so changed code fits again.
+    (:func:`model_code_digest`), so changed code fits again.  With
+    ``memory``, also the MB by which the fit raised the process's peak
+    resident memory (:func:`peak_memory`; None when unknown).
     """
     key = hashlib.sha1(model_code_digest().encode())
     key.update(type(model).__name__.encode())
@@ -331,13 +334,41 @@ def cached_fit(model, X, sequence_ids, **fit_params):
     for name, value in sorted(fit_params.items()):
         key.update(name.encode() + np.ascontiguousarray(value).tobytes())
     path = CACHE / f"{type(model).__name__}_{key.hexdigest()[:24]}.joblib"
+    memory_path = path.with_suffix(".MB")  # apart: older code reads the fit
     if path.exists():
-        return joblib.load(path)
-    fit = partial(model.fit, X, sequence_ids=sequence_ids, **fit_params)
-    result = (model, seconds(fit))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    joblib.dump(result, path)
-    return result
+        result = joblib.load(path)
+    else:
+        fit = partial(model.fit, X, sequence_ids=sequence_ids, **fit_params)
+        with peak_memory() as added:
+            result = (model, seconds(fit))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        joblib.dump(result, path)
+        memory_path.write_text(str(added.get("MB")))
+    if not memory:
+        return result
+    added = memory_path.read_text() if memory_path.exists() else "None"
+    return (*result, None if added == "None" else float(added))
+
+
+@contextmanager
+def peak_memory():
+    """A dict whose ``"MB"`` is, on leaving, how far the block raised the peak
+    resident memory above the memory at its start (Linux; absent elsewhere)."""
+    added = {}
+    try:  # freed heap pages back to the system, so that new ones count
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+        Path("/proc/self/clear_refs").write_text("5")  # the peak := the current
+
+        def status(key):
+            text = Path("/proc/self/status").read_text()
+            return int(text.split(key + ":")[1].split()[0]) / 1024
+
+        start = status("VmRSS")
+    except (OSError, IndexError, AttributeError):
+        yield added
+        return
+    yield added
+    added["MB"] = status("VmHWM") - start
 
 
 # ----------------------------------------------------------------- fill-in

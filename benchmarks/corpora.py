@@ -52,7 +52,7 @@ from sklearn_crbm.metrics import (
     most_moving_channels,
     step_frequency,
 )
-from sklearn_crbm.preprocessing import MotionPipeline, make_motion_preprocessor
+from sklearn_crbm.preprocessing import make_motion_preprocessor
 
 CYCLIC = ("walk", "walk-turn-left", "walk-turn-right", "run") + tuple(
     f"wave-{part}" for part in ("both-hands", "left-hand", "right-hand")
@@ -75,16 +75,18 @@ class Content:
 
     def __init__(self, data_home, name, style="normal"):
         folder = Path(data_home) / "bandai_dataset2"
-        self.name = name
-        self.takes = takes = read_bvh_folder(
-            folder, pattern=f"dataset-2_{name}_{style}_*.bvh"
-        )
-        self.skeleton = takes.skeleton
-        self.preprocessor = make_motion_preprocessor(takes.skeleton)
+        takes = read_bvh_folder(folder, pattern=f"dataset-2_{name}_{style}_*.bvh")
+        preprocessor = make_motion_preprocessor(takes.skeleton)
         with sklearn.config_context(enable_metadata_routing=True):
-            self.Z = self.preprocessor.fit_transform(
-                takes.data, sequence_ids=takes.sequence_ids
-            )
+            Z = preprocessor.fit_transform(takes.data, sequence_ids=takes.sequence_ids)
+        self.describe(name, takes, preprocessor, Z)
+
+    def describe(self, name, takes, preprocessor, Z):
+        """Keep ``takes`` (``data``, ``sequence_ids``, ``skeleton``), ``Z`` (them
+        through the fitted ``preprocessor``) and the real takes' statistics."""
+        self.name, self.takes, self.Z = name, takes, Z
+        self.skeleton = takes.skeleton
+        self.preprocessor = preprocessor
         self.blown_z = 2 * float(np.abs(self.Z).max())
         names = self.preprocessor.get_feature_names_out()
         self.angles = [j for j, n in enumerate(names) if n.endswith(ANGLES)]
@@ -156,15 +158,24 @@ def _travelling_joint(positions):
 def judge(content, model, seed, sample_params=None):
     """Every statistic of the sequences that ``model`` generates (``sample``
     given ``sample_params``)."""
-    pipeline = MotionPipeline([*content.preprocessor.steps, ("model", model)])
     history = content.seed(max(model.history_length, 1))
+    return describe(content, *generate(model, history, seed, sample_params))
+
+
+def generate(model, history, seed, sample_params=None):
+    """``(Z, warnings caught, seconds)``: ``N_FRAMES`` after each ``history``."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", GenerationWarning)
         start = time.perf_counter()
         Z = model.sample(
             N_FRAMES, history=history, random_state=seed, **(sample_params or {})
         )
-        sample_seconds = time.perf_counter() - start
+    return Z, caught, time.perf_counter() - start
+
+
+def describe(content, Z, caught=(), sample_seconds=None):
+    """Every statistic of the generated ``Z`` (``N_SEQUENCES`` sequences of
+    ``N_FRAMES``) against the real takes of ``content``."""
     ids = np.repeat(np.arange(N_SEQUENCES), N_FRAMES)
     judged = np.tile(np.arange(N_FRAMES), N_SEQUENCES)
     judged = (judged >= JUDGED.start) & (judged < JUDGED.stop)
@@ -176,7 +187,7 @@ def judge(content, model, seed, sample_params=None):
     Z = np.where(np.isfinite(Z), np.clip(Z, -1e3, 1e3), 0.0)  # judge what is left
     unscaled = content.unscaled(Z)
     with sklearn.config_context(enable_metadata_routing=True):
-        raw = pipeline[:-1].inverse_transform(Z, sequence_ids=ids)
+        raw = content.preprocessor.inverse_transform(Z, sequence_ids=ids)
     positions = content.positions(raw)[judged]
     lively, lively_whole = (
         liveliness(
