@@ -129,6 +129,23 @@ def test_a_split_that_cuts_a_sequence_warns(walks):
         model.fit(walks.data[:10])  # part of one take, deliberately
 
 
+def test_whole_takes_that_share_a_frame_with_another_are_not_called_cut(tmp_path):
+    # two takes of a corpus can hold the same frame (a rest pose): taking
+    # one of them whole must not read as cutting it
+    walker = make_walker(n_sequences=1, n_frames=20, random_state=10)
+    other = make_walker(n_sequences=1, n_frames=20, random_state=11).data
+    other[5] = walker.data[12]
+    for name, data in (("a", walker.data), ("b", other), ("c", walker.data[::-1])):
+        write_bvh(tmp_path / f"walk_{name}.bvh", data, walker.skeleton, 30.0)
+    takes = read_bvh_folder(tmp_path)
+    first_two = takes.sequence_ids < 2
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ConditionalRBM(4, n_iter=1).fit(
+            takes.data[first_two], sequence_ids=takes.sequence_ids[first_two]
+        )
+
+
 # -- float32 in, float32 out ---------------------------------------------------
 
 

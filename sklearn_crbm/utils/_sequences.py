@@ -56,14 +56,27 @@ class _LoadedSequences:
         """The row of ``data`` equal to each row of ``X`` (-1 where none),
         matched by a 64-bit hash of the rows' bytes: 16 bytes a row of
         ``data``, built on the first look-up."""
-        if self._sorted is None:
-            hashes = _row_hashes(data)
-            order = np.argsort(hashes, kind="stable")
-            self._sorted = hashes[order], order
-        hashes, order = self._sorted
+        hashes, order, _ = self._hash_index(data)
         wanted = _row_hashes(X)
         at = np.minimum(np.searchsorted(hashes, wanted), len(hashes) - 1)
         return np.where(hashes[at] == wanted, order[at], -1)
+
+    def repeated_rows(self, data):
+        """Where a row of ``data`` equals another row (a frame that two
+        takes, or two moments of one, share): such a row says nothing of
+        which sequence a copy of it came from."""
+        return self._hash_index(data)[2]
+
+    def _hash_index(self, data):
+        if self._sorted is None:
+            hashes = _row_hashes(data)
+            order = np.argsort(hashes, kind="stable")
+            sorted_hashes = hashes[order]
+            repeated = np.zeros(len(hashes), dtype=bool)
+            same = sorted_hashes[1:] == sorted_hashes[:-1]
+            repeated[order[1:][same]] = repeated[order[:-1][same]] = True
+            self._sorted = sorted_hashes, order, repeated
+        return self._sorted
 
 
 def _row_hashes(X):
@@ -110,7 +123,10 @@ def _copied_loader_ids(X):
             continue
         rows = entry.rows_of(data, X)
         if (rows >= 0).all():
-            return entry.sequence_ids[rows], entry.sequence_ids
+            # rows that several frames share are left out of the count
+            repeated = entry.repeated_rows(data)
+            rows = rows[~repeated[rows]]
+            return entry.sequence_ids[rows], entry.sequence_ids[~repeated]
     return None
 
 
