@@ -50,6 +50,12 @@ PACKAGE = Path(sklearn_crbm.__file__).resolve().parent
 # The paper's model on CMU subject 35 after preprocessing (62 channels).
 PAPER = dict(n_features=62, n_components=200, order=3, batch_size=100)
 
+
+def paper_model(**params):
+    """``ConditionalRBM`` of the paper's size (200 hidden units, order 3)."""
+    return ConditionalRBM(PAPER["n_components"], order=PAPER["order"], **params)
+
+
 # CMU 35 train/test splits: one walk and one jog held out.  "paper" is the
 # paper's §4.4 split; "second" holds out trials of similar lengths.
 SPLITS = {"paper": ("35_29", "35_18"), "second": ("35_05", "35_22")}
@@ -137,14 +143,9 @@ def _cpu_name():
 
 # -------------------------------------------------------------------- data
 class Split:
-    """One split of CMU subject 35: training trials and the erased test cases.
-
-    The preprocessing (the paper's encoding) is fitted on the training trials.
-    ``cases`` maps ``"walk/leg"`` ... ``"jog/upper"`` to the cases of
-    :func:`~sklearn_crbm.model_selection.make_fillin_cases`: the left leg or
-    the upper body of a held-out trial erased from half-way to the end.
-    ``X_test``/``test_ids`` are the two held-out trials, walk first.
-    """
+    """One split of CMU subject 35, preprocessed (the paper's encoding) as
+    fitted on its training trials; ``cases``: ``"walk/leg"`` ... ``"jog/upper"``
+    (``make_fillin_cases``); ``X_test``/``test_ids``: the held-out walk, jog."""
 
     def __init__(self, data_home, name):
         self.cmu = cmu = load_cmu35(data_home)
@@ -169,13 +170,9 @@ class Split:
 
 
 class MotionCorpus:
-    """Real motion of known styles, preprocessed, with the judge of generated motion.
-
-    ``name`` is ``"cmu"`` (all 33 trials of CMU subject 35, walks and jogs)
-    or ``"mit"`` (Taylor's MIT walks); ``encoding`` holds parameters of
-    ``make_motion_preprocessor``.  ``real`` gives the mean leg amplitude and
-    step frequency of the real sequences of each style.
-    """
+    """Real motion of known styles (``name``: ``"cmu"``, all 33 trials of CMU 35,
+    or ``"mit"``), preprocessed (``encoding``), the judge of generated motion,
+    and ``real``: each style's mean leg amplitude and step frequency."""
 
     LEGS = {
         "cmu": ("lfemur", "rfemur", "ltibia", "rtibia"),
@@ -250,11 +247,8 @@ def synthetic_motion(n_frames, n_features, n_sequences, dtype=np.float64, seed=0
 
 
 def load_training_data(name, data_home, dtype=np.float64):
-    """``(X, sequence_ids, source)``: "cmu35" or "mit", preprocessed.
-
-    Where the data is missing, a synthetic stand-in of the same shape, and
-    ``source`` says so.
-    """
+    """``(X, sequence_ids, source)``: "cmu35" or "mit", preprocessed, or
+    (``source`` says so) a synthetic stand-in of its shape where it is missing."""
     try:
         bunch = (
             load_cmu35(data_home, subset="train")
@@ -285,11 +279,7 @@ _IN_A_FIT = {"metrics/_liveliness.py", "metrics/_generation.py"}
 
 
 def model_code_digest():
-    """A digest of every module of the package under test that a fit can run.
-
-    Docstrings and comments are left out: a change of the documentation
-    alone does not refit.
-    """
+    """A digest of the package's modules a fit can run, without docstrings."""
     digest = hashlib.sha1()
     for path in sorted(PACKAGE.rglob("*.py")):
         relative = path.relative_to(PACKAGE)
@@ -318,14 +308,8 @@ def _code(path):
 
 
 def cached_fit(model, X, sequence_ids, *, memory=False, **fit_params):
-    """``(fitted model, fit seconds)``, read from the cache when it is there.
-
-    The key is the model's class and parameters, the data (with the arrays
-    in ``fit_params``, such as ``context``) and the package's code
-    (:func:`model_code_digest`), so changed code fits again.  With
-    ``memory``, also the MB by which the fit raised the process's peak
-    resident memory (:func:`peak_memory`; None when unknown).
-    """
+    """``(fitted model, fit seconds)``, cached (README.md: the key); with
+    ``memory``, also the MB the fit added to the peak RSS (None: unknown)."""
     key = hashlib.sha1(model_code_digest().encode())
     key.update(type(model).__name__.encode())
     key.update(repr(sorted(model.get_params().items())).encode())
@@ -387,11 +371,8 @@ def fitted_baselines(X, sequence_ids):
 
 
 def crbm_imputer(X, sequence_ids, seed, model_params=None, imputer_params=None):
-    """``(CRBMImputer, fit seconds)``: the defaults, around a cached model fit.
-
-    ``model_params`` and ``imputer_params`` change the defaults of
-    ``ConditionalRBM`` and ``CRBMImputer``.
-    """
+    """``(CRBMImputer, fit seconds)`` around a cached ``ConditionalRBM`` fit;
+    ``model_params``, ``imputer_params`` change the two's defaults."""
     model = ConditionalRBM(random_state=seed, **(model_params or {}))
     fitted, fit_seconds = cached_fit(model, X, sequence_ids)
     imputer = frozen_imputer(fitted, X, sequence_ids, seed, **(imputer_params or {}))
@@ -422,11 +403,8 @@ def print_errors(errors, title, with_paper=False):
 
 
 def log_ratio_row(name, log_ratios):
-    """Mean log error ratio over seeds, its interval, and the cells won.
-
-    ``log_ratios``: ``log(CRBM error / reference error)``, one row per
-    training seed (and any number of cells per row).
-    """
+    """Mean over seeds (rows) of ``log(CRBM error / reference error)``, its
+    interval, the verdict and the cells won."""
     mean, low, high = bootstrap_mean(log_ratios)
     verdict = "better" if high < 0 else "worse" if low > 0 else "not significant"
     won, of = int(np.sum(np.asarray(log_ratios) < 0)), int(np.size(log_ratios))
@@ -450,18 +428,21 @@ def log_ratio_columns(reference="best baseline"):
 
 # ------------------------------------------------------------- statistics
 def bootstrap_mean(values, n_resamples=10_000, level=0.95, seed=0):
-    """Mean of ``values`` and its percentile bootstrap interval over seeds.
-
-    ``values`` has one row per training seed (and any number of cells per
-    row); the rows are resampled with replacement, drawn from ``seed`` (an
-    int or a ``numpy.random.Generator``).  Returns ``(mean, low, high)``.
-    """
+    """``(mean, low, high)``: the mean of ``values`` and its percentile bootstrap
+    interval, resampling the rows (seeds) with ``seed`` (an int or Generator)."""
     n = len(values)
     values = np.asarray(values, dtype=float).reshape(n, -1)
     rows = np.random.default_rng(seed).integers(n, size=(n_resamples, n))
     means = values[rows].mean(axis=(1, 2))
     low, high = np.quantile(means, [(1 - level) / 2, (1 + level) / 2])
     return float(values.mean()), float(low), float(high)
+
+
+def interval_text(values, percent=False, spec=".2f", seed=0):
+    """:func:`bootstrap_mean` as text: ``0.12 [0.10, 0.14]`` or ``12% [10, 14]``."""
+    scale, spec = (100, ".0f") if percent else (1, spec)
+    mean, low, high = (scale * v for v in bootstrap_mean(values, seed=seed))
+    return f"{mean:{spec}}{'%' if percent else ''} [{low:{spec}}, {high:{spec}}]"
 
 
 # ------------------------------------------------------------------ timing
@@ -533,12 +514,8 @@ def epoch_batch_sizes(n_frames, batch_size):
 
 
 class EpochProducts:
-    """The six matrix products of every minibatch of one CD-1 epoch, alone.
-
-    The shapes and memory layouts of training (weights in Fortran order),
-    into preallocated outputs: the time no implementation that leaves these
-    products to BLAS can beat.
-    """
+    """The six matrix products of every minibatch of one CD-1 epoch, alone, in
+    training's shapes and layouts: the time no BLAS-based fit can beat."""
 
     def __init__(self, n_features, n_components, order, batch_size, dtype):
         rng = np.random.default_rng(0)

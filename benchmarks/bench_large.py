@@ -22,21 +22,9 @@ os.environ.setdefault("SCIPY_ARRAY_API", "1")  # before SciPy is imported
 import tracemalloc  # noqa: E402
 from functools import partial  # noqa: E402
 
+import _common as common  # noqa: E402
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
-from _common import (  # noqa: E402
-    EpochProducts,
-    announce,
-    cd_epoch_flops,
-    epoch_batch_sizes,
-    frames_with_history,
-    gemm_peak,
-    print_table,
-    seconds,
-    synthetic_motion,
-    threadpool_limits,
-    write_json,
-)
 
 from sklearn_crbm import ConditionalRBM  # noqa: E402
 
@@ -78,39 +66,40 @@ def rate_row(keys, task, frames, elapsed, flops=None, **measured):
 def cpu_rows(args, X, ids, dtype, threads):
     part = first_sequences(ids, args.train_frames)
     X_train, ids_train = X[part], ids[part]
-    valid = frames_with_history(ids_train, args.order)
-    flops = cd_epoch_flops(len(valid), X.shape[1], args.components, args.order)
+    valid = common.frames_with_history(ids_train, args.order)
+    flops = common.cd_epoch_flops(len(valid), X.shape[1], args.components, args.order)
     # memory: a short run of the same call (its buffers do not grow with X)
     short = first_sequences(ids, 5000)
     keys = dict(dtype=np.dtype(dtype).name, threads=threads)
-    with threadpool_limits(threads):  # how much the threads give on a large product
-        rows = [dict(keys, device="cpu", task="gemm 2000", gflops=gemm_peak(dtype)[0])]
+    with common.threadpool_limits(threads):  # what threads give a large product
+        gflops = common.gemm_peak(dtype)[0]
+    rows = [dict(keys, device="cpu", task="gemm 2000", gflops=gflops)]
     for batch_size in args.batch_sizes:
-        sizes = epoch_batch_sizes(len(valid), batch_size)
-        products = EpochProducts(
+        sizes = common.epoch_batch_sizes(len(valid), batch_size)
+        products = common.EpochProducts(
             X.shape[1], args.components, args.order, batch_size, dtype
         )
         start = partial(started, args, batch_size, X[short], ids[short])
-        with threadpool_limits(threads):
+        with common.threadpool_limits(threads):
             estimator = start()  # warmed up: started on a few frames, timed on many
             products.epoch(sizes[:5])
             train = partial(estimator.partial_fit, X_train, sequence_ids=ids_train)
             epoch = partial(products.epoch, sizes)
             # interleaved: load changes hit both
-            pairs = [(seconds(train), seconds(epoch)) for _ in range(args.repeats)]
+            pairs = [
+                (common.seconds(train), common.seconds(epoch))
+                for _ in range(args.repeats)
+            ]
             train_s, products_s = (min(t) for t in zip(*pairs, strict=True))
             peak = peak_mb(start)
         batch, n = dict(keys, batch=batch_size, device="cpu"), len(valid)
         over = train_s / products_s
-        rows.append(
-            rate_row(
-                batch, "train", n, train_s, flops, peak_mb=peak, over_products=over
-            )
-        )
+        extra = dict(peak_mb=peak, over_products=over)
+        rows.append(rate_row(batch, "train", n, train_s, flops, **extra))
         rows.append(rate_row(batch, "products", n, products_s, flops))
     generate = partial(estimator.sample, n_sequences=args.sequences, random_state=0)
-    with threadpool_limits(threads):
-        elapsed = seconds(partial(generate, args.gen_frames), args.repeats)
+    with common.threadpool_limits(threads):
+        elapsed = common.seconds(partial(generate, args.gen_frames), args.repeats)
         peak = peak_mb(partial(generate, 1))
     frames = args.gen_frames * args.sequences
     cpu = dict(keys, device="cpu")
@@ -133,7 +122,7 @@ def gpu_rows(args, torch, X, ids, dtype):
     cuda = torch.cuda
     part = first_sequences(ids, args.gpu_train_frames)
     ids_train = ids[part]
-    valid = frames_with_history(ids_train, args.order)
+    valid = common.frames_with_history(ids_train, args.order)
     keys = dict(dtype=np.dtype(dtype).name, threads=None)
     rows = []
     with sklearn.config_context(array_api_dispatch=True):
@@ -143,15 +132,14 @@ def gpu_rows(args, torch, X, ids, dtype):
             cuda.reset_peak_memory_stats()
             estimator = model(args, batch_size)
             train = partial(estimator.partial_fit, X_gpu, sequence_ids=ids_train)
-            elapsed = seconds(train, args.repeats, cuda.synchronize)
+            elapsed = common.seconds(train, args.repeats, cuda.synchronize)
             batch = dict(keys, batch=batch_size, device=cuda.get_device_name())
             peak = cuda.max_memory_allocated() / 1e6
             rows.append(rate_row(batch, "train", len(valid), elapsed, peak_mb=peak))
         cuda.reset_peak_memory_stats()
         generate = partial(estimator.sample, n_sequences=args.sequences, random_state=0)
-        elapsed = seconds(
-            partial(generate, args.gen_frames), args.repeats, cuda.synchronize
-        )
+        generate = partial(generate, args.gen_frames)
+        elapsed = common.seconds(generate, args.repeats, cuda.synchronize)
     frames, peak = args.gen_frames * args.sequences, cuda.max_memory_allocated() / 1e6
     device = dict(keys, device=cuda.get_device_name())
     rows.append(rate_row(device, "sample", frames, elapsed, peak_mb=peak))
@@ -191,41 +179,37 @@ def main(argv=None):
     add("--repeats", type=int, default=3, help="timed calls per row (best is kept)")
     add("--output", default=None)
     args = parser.parse_args(argv)
-    announce()
+    common.announce()
     torch, no_gpu = cuda_device()
     rows, corpora = [], {}
     for dtype_name in args.dtypes:
         dtype = np.dtype(dtype_name).type
         n_sequences = max(1, args.frames // 1000)
-        X, ids = synthetic_motion(args.frames, args.features, n_sequences, dtype)
+        X, ids = common.synthetic_motion(args.frames, args.features, n_sequences, dtype)
         corpora[dtype_name] = f"synthetic, {args.frames} x {args.features}"
         for threads in args.threads:
             rows.extend(cpu_rows(args, X, ids, dtype, threads))
         if torch is not None:
             rows.extend(gpu_rows(args, torch, X, ids, dtype))
-    columns = [
-        *("task", "device", "dtype", "threads", "batch", "frames"),
-        ("seconds", "s", ".2f"),
-        ("frames_per_s", "frames/s", ",.0f"),
-        ("gflops", "GFLOP/s", ".1f"),
-        ("over_products", "/ products", ".2f"),
-        ("peak_mb", "peak MB", ",.0f"),
-    ]
+    columns = ["task", "device", "dtype", "threads", "batch", "frames",
+               ("seconds", "s", ".2f"), ("frames_per_s", "frames/s", ",.0f"),
+               ("gflops", "GFLOP/s", ".1f"), ("over_products", "/ products", ".2f"),
+               ("peak_mb", "peak MB", ",.0f")]  # fmt: skip
     title = (
         f"{corpora[args.dtypes[0]]}, {args.components} hidden units, order "
         f"{args.order}; {args.sequences} sequences generated together"
     )
-    print_table(rows, columns, title=title)
+    common.print_table(rows, columns, title=title)
     gains = speedups(rows)
     if no_gpu:
         print(f"No GPU rows: {no_gpu}.")
     else:
-        print_table(
+        common.print_table(
             gains, ["task", "dtype", "batch", ("speedup", "GPU / best CPU", ".1f")]
         )
     gpu = no_gpu or torch.cuda.get_device_name()
     payload = dict(config=vars(args), corpus=corpora, gpu=gpu, rows=rows)
-    write_json("bench_large", args.output, **payload, gpu_over_cpu=gains)
+    common.write_json("bench_large", args.output, **payload, gpu_over_cpu=gains)
 
 
 if __name__ == "__main__":

@@ -94,37 +94,17 @@ def main():
                 for _ in range(args.repeats)
             ]
             wall, cpu = min(t[0] for t in times), min(t[1] for t in times)
-            rows.append(
-                {
-                    "case": name,
-                    "MB": megabytes,
-                    "wall_s": wall,
-                    "cpu_s": cpu,
-                    "cpu_s_per_MB": cpu / megabytes,
-                    "within": "yes" if cpu / megabytes < BUDGET_S_PER_MB else "NO",
-                }
-            )
-    print_table(
-        rows,
-        [
-            "case",
-            ("MB", "MB", ".2f"),
-            ("wall_s", "wall s", ".3f"),
-            ("cpu_s", "CPU s", ".3f"),
-            ("cpu_s_per_MB", "CPU s per MB", ".3f"),
-            ("within", f"under {BUDGET_S_PER_MB:g} s/MB", ""),
-        ],
-        title=f"Readers, best of {args.repeats} calls",
-    )
-    write_json(
-        "bench_readers",
-        args.output,
-        rows=rows,
-        joints=args.joints,
-        bones=args.bones,
-        repeats=args.repeats,
-        budget_s_per_mb=BUDGET_S_PER_MB,
-    )
+            within = "yes" if cpu / megabytes < BUDGET_S_PER_MB else "NO"
+            rows.append({"case": name, "MB": megabytes, "wall_s": wall,
+                         "cpu_s": cpu, "cpu_s_per_MB": cpu / megabytes,
+                         "within": within})  # fmt: skip
+    columns = ["case", ("MB", "MB", ".2f"), ("wall_s", "wall s", ".3f"),
+               ("cpu_s", "CPU s", ".3f"), ("cpu_s_per_MB", "CPU s per MB", ".3f"),
+               ("within", f"under {BUDGET_S_PER_MB:g} s/MB", "")]  # fmt: skip
+    print_table(rows, columns, title=f"Readers, best of {args.repeats} calls")
+    write_json("bench_readers", args.output, rows=rows, joints=args.joints,
+               bones=args.bones, repeats=args.repeats,
+               budget_s_per_mb=BUDGET_S_PER_MB)  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -12,33 +12,21 @@ Run from the repository root (about two minutes)::
     python benchmarks/bench_scaling.py --dtypes float64 float32 --repeats 5
 """
 
-from _common import (
-    PAPER,
-    announce,
-    cd_epoch_flops,
-    frames_with_history,
-    gemm_peak,
-    print_table,
-    speed_parser,
-    summary,
-    synthetic_motion,
-    threadpool_limits,
-    time_both,
-    write_json,
-)
+import _common as common
 
 from sklearn_crbm import ConditionalRBM
 
 
 def epoch_cost(X, ids, n_components, order, epochs, repeats, peak):
-    n_train = len(frames_with_history(ids, order))
+    n_train = len(common.frames_with_history(ids, order))
     walls, cpus = [], []
     for _ in range(repeats):
         model = ConditionalRBM(n_components, order=order, n_iter=epochs, random_state=0)
-        wall, cpu = time_both(lambda model=model: model.fit(X, sequence_ids=ids))
+        wall, cpu = common.time_both(lambda model=model: model.fit(X, sequence_ids=ids))
         walls.append(wall / epochs)
         cpus.append(cpu / epochs)
-    gflops = cd_epoch_flops(n_train, X.shape[1], n_components, order) / min(cpus) / 1e9
+    flops = common.cd_epoch_flops(n_train, X.shape[1], n_components, order)
+    gflops = flops / min(cpus) / 1e9
     return dict(
         n_train_frames=n_train,
         ms_per_epoch=1e3 * min(walls),
@@ -46,12 +34,12 @@ def epoch_cost(X, ids, n_components, order, epochs, repeats, peak):
         cpu_us_per_frame=1e6 * min(cpus) / n_train,
         cpu_gflops=gflops,
         percent_of_peak=100 * gflops / peak,
-        times={"wall": summary(walls), "cpu": summary(cpus)},
+        times={"wall": common.summary(walls), "cpu": common.summary(cpus)},
     )
 
 
 def main(argv=None):
-    p = speed_parser(__doc__, threads=(1,))
+    p = common.speed_parser(__doc__, threads=(1,))
     p.set_defaults(dtypes=["float32"], repeats=2)
     p.add_argument(
         "--frames", type=int, nargs="+", default=[10**3, 10**4, 10**5, 10**6]
@@ -62,40 +50,36 @@ def main(argv=None):
     )
     p.add_argument("--epochs", type=int, default=3, help="epochs per fit (small data)")
     args = p.parse_args(argv)
-    announce()
-    d, h, order = PAPER["n_features"], PAPER["n_components"], PAPER["order"]
+    common.announce()
+    d, h, order = (common.PAPER[k] for k in ("n_features", "n_components", "order"))
     rows = []
     for dtype in args.dtypes:
         for threads in args.threads:
-            with threadpool_limits(threads):
-                peak = gemm_peak(dtype)[1]  # CPU clock, like the rows
+            with common.threadpool_limits(threads):
+                peak = common.gemm_peak(dtype)[1]  # CPU clock, like the rows
                 sweeps = [("frames", n, n, h, order) for n in args.frames]
                 sweeps += [("order", q, 2644, h, q) for q in args.orders]
                 sweeps += [("n_components", k, 2644, k, order) for k in args.components]
                 for sweep, value, n, n_components, q in sweeps:
-                    X, ids = synthetic_motion(n, d, max(1, n // 100), dtype=dtype)
+                    n_sequences = max(1, n // 100)
+                    X, ids = common.synthetic_motion(n, d, n_sequences, dtype=dtype)
                     big = n >= 100_000  # one epoch, one fit: seconds each
                     epochs, repeats = (1, 1) if big else (args.epochs, args.repeats)
                     row = epoch_cost(X, ids, n_components, q, epochs, repeats, peak)
                     rows.append(dict(sweep=sweep, value=value, dtype=dtype, **row))
                     ms = row["ms_per_epoch"]
                     print(f"  {sweep}={value}: {ms:.1f} ms/epoch", flush=True)
-    table = print_table(
-        rows,
-        [
-            "sweep",
-            ("value", "value", ",d"),
-            "dtype",
-            ("n_train_frames", "train frames", ",d"),
-            ("ms_per_epoch", "ms/epoch", ",.1f"),
-            ("cpu_ms_per_epoch", "CPU ms/epoch", ",.1f"),
-            ("cpu_us_per_frame", "CPU us/frame", ".2f"),
-            ("cpu_gflops", "GFLOP/s (CPU)", ".1f"),
-            ("percent_of_peak", "% of peak (CPU)", ".0f"),
-        ],
-        title="\nTraining cost per epoch (62 dims; 200 hidden, order 3 unless swept)",
-    )
-    write_json("bench_scaling", args.output, args=vars(args), rows=rows, table=table)
+    columns = ["sweep", ("value", "value", ",d"), "dtype",
+               ("n_train_frames", "train frames", ",d"),
+               ("ms_per_epoch", "ms/epoch", ",.1f"),
+               ("cpu_ms_per_epoch", "CPU ms/epoch", ",.1f"),
+               ("cpu_us_per_frame", "CPU us/frame", ".2f"),
+               ("cpu_gflops", "GFLOP/s (CPU)", ".1f"),
+               ("percent_of_peak", "% of peak (CPU)", ".0f")]  # fmt: skip
+    title = "\nTraining cost per epoch (62 dims; 200 hidden, order 3 unless swept)"
+    table = common.print_table(rows, columns, title=title)
+    payload = dict(args=vars(args), rows=rows, table=table)
+    common.write_json("bench_scaling", args.output, **payload)
 
 
 if __name__ == "__main__":

@@ -17,23 +17,8 @@ Run from the repository root (a few minutes)::
 
 from functools import partial
 
+import _common as common
 import numpy as np
-from _common import (
-    PAPER,
-    EpochProducts,
-    announce,
-    cd_epoch_flops,
-    epoch_batch_sizes,
-    frames_with_history,
-    gemm_peak,
-    load_training_data,
-    print_table,
-    speed_parser,
-    summary,
-    threadpool_limits,
-    time_both,
-    write_json,
-)
 from scipy.special import expit
 
 from sklearn_crbm import ConditionalRBM
@@ -89,11 +74,11 @@ class NaiveCD:
 
 def run_config(name, X, ids, dtype, threads, args):
     X, d = X.astype(dtype), X.shape[1]
-    h, order, bs = PAPER["n_components"], PAPER["order"], PAPER["batch_size"]
-    frames = frames_with_history(ids, order)
-    flops = cd_epoch_flops(len(frames), d, h, order)
-    sizes = epoch_batch_sizes(len(frames), bs)
-    products = EpochProducts(d, h, order, bs, dtype)
+    h, order, bs = (common.PAPER[k] for k in ("n_components", "order", "batch_size"))
+    frames = common.frames_with_history(ids, order)
+    flops = common.cd_epoch_flops(len(frames), d, h, order)
+    sizes = common.epoch_batch_sizes(len(frames), bs)
+    products = common.EpochProducts(d, h, order, bs, dtype)
     naive = NaiveCD(d, h, order, dtype)
 
     model = partial(ConditionalRBM, h, order=order, batch_size=bs, random_state=0)
@@ -111,33 +96,26 @@ def run_config(name, X, ids, dtype, threads, args):
         ],
     }
     times, peaks = {k: [] for k in timed}, []
-    with threadpool_limits(threads):
+    with common.threadpool_limits(threads):
         model(n_iter=1).fit(X, sequence_ids=ids)  # warm up
         for _ in range(args.repeats):  # interleaved: load changes hit all alike
-            peaks.append(gemm_peak(dtype))
+            peaks.append(common.gemm_peak(dtype))
             for key, func in timed.items():
-                times[key].append(time_both(func))
+                times[key].append(common.time_both(func))
     peak_wall, peak_cpu = (max(p) for p in zip(*peaks, strict=True))
     rows = []
     for impl, ts in times.items():
         wall, cpu = (np.array(t) / args.epochs for t in zip(*ts, strict=True))
         cpu_percent = 100 * flops / cpu.min() / 1e9 / peak_cpu
-        rows.append(
-            dict(
-                config=name,
-                impl=impl,
-                dtype=np.dtype(dtype).name,
-                threads=threads,
-                ms_per_epoch=1e3 * wall.min(),
-                ms_per_epoch_median=1e3 * float(np.median(wall)),
-                cpu_ms_per_epoch=1e3 * cpu.min(),
-                frames_per_s=len(frames) / wall.min(),
-                gflops=flops / wall.min() / 1e9,
-                percent_of_peak=100 * flops / wall.min() / 1e9 / peak_wall,
-                cpu_percent_of_peak=cpu_percent if threads == 1 else None,
-                times={"wall": summary(list(wall)), "cpu": summary(list(cpu))},
-            )
-        )
+        spread = {"wall": common.summary(list(wall)), "cpu": common.summary(list(cpu))}
+        rows.append(dict(config=name, impl=impl, dtype=np.dtype(dtype).name,
+            threads=threads, ms_per_epoch=1e3 * wall.min(),
+            ms_per_epoch_median=1e3 * float(np.median(wall)),
+            cpu_ms_per_epoch=1e3 * cpu.min(), frames_per_s=len(frames) / wall.min(),
+            gflops=flops / wall.min() / 1e9,
+            percent_of_peak=100 * flops / wall.min() / 1e9 / peak_wall,
+            cpu_percent_of_peak=cpu_percent if threads == 1 else None,
+            times=spread))  # fmt: skip
     ours, naive_row, alone = rows
     ours["x_naive"] = naive_row["ms_per_epoch"] / ours["ms_per_epoch"]
     ours["vs_products"] = ours["ms_per_epoch"] / alone["ms_per_epoch"]
@@ -146,17 +124,19 @@ def run_config(name, X, ids, dtype, threads, args):
 
 
 def main(argv=None):
-    p = speed_parser(__doc__)
+    p = common.speed_parser(__doc__)
     p.add_argument("--epochs", type=int, default=10, help="epochs per timed fit")
     p.add_argument("--no-mit", action="store_true", help="skip the MIT configuration")
     args = p.parse_args(argv)
-    announce()
+    common.announce()
     rows, sources = [], {}
     datasets = {"cmu35": "CMU 35, 62-200, order 3", "mit": "MIT walk, 49-200, order 3"}
     for data_name, label in datasets.items():
         if data_name == "mit" and args.no_mit:
             continue
-        X, ids, sources[data_name] = load_training_data(data_name, args.data_home)
+        X, ids, sources[data_name] = common.load_training_data(
+            data_name, args.data_home
+        )
         for dtype in args.dtypes:
             for threads in args.threads:
                 if data_name == "mit" and (dtype, threads) != ("float64", 1):
@@ -166,29 +146,20 @@ def main(argv=None):
         if row["config"].startswith("MIT") and row["impl"] == "sklearn_crbm":
             row["x_matlab"] = MATLAB_MIT_SECONDS_PER_EPOCH / (row["ms_per_epoch"] / 1e3)
     print(f"data: {sources}")
-    table = print_table(
-        rows,
-        [
-            ("config", "configuration", "s"),
-            ("impl", "implementation", "s"),
-            "dtype",
-            "threads",
-            ("ms_per_epoch", "ms/epoch (best)", ".2f"),
-            ("ms_per_epoch_median", "median", ".2f"),
-            ("cpu_ms_per_epoch", "CPU ms/epoch", ".2f"),
-            ("frames_per_s", "frames/s", ",.0f"),
-            ("gflops", "GFLOP/s", ".1f"),
-            ("percent_of_peak", "% of peak", ".0f"),
-            ("cpu_percent_of_peak", "% of peak (CPU)", ".0f"),
-            ("x_naive", "x naive", ".2f"),
-            ("vs_products", "/ products", ".2f"),
-            ("cpu_vs_products", "/ products (CPU)", ".2f"),
-            ("x_matlab", "x MATLAB", ".1f"),
-        ],
-        title="\nTraining, CD-1, batch 100",
-    )
+    columns = [("config", "configuration", "s"), ("impl", "implementation", "s"),
+               "dtype", "threads", ("ms_per_epoch", "ms/epoch (best)", ".2f"),
+               ("ms_per_epoch_median", "median", ".2f"),
+               ("cpu_ms_per_epoch", "CPU ms/epoch", ".2f"),
+               ("frames_per_s", "frames/s", ",.0f"), ("gflops", "GFLOP/s", ".1f"),
+               ("percent_of_peak", "% of peak", ".0f"),
+               ("cpu_percent_of_peak", "% of peak (CPU)", ".0f"),
+               ("x_naive", "x naive", ".2f"), ("vs_products", "/ products", ".2f"),
+               ("cpu_vs_products", "/ products (CPU)", ".2f"),
+               ("x_matlab", "x MATLAB", ".1f")]  # fmt: skip
+    title = "\nTraining, CD-1, batch 100"
+    table = common.print_table(rows, columns, title=title)
     payload = dict(args=vars(args), data=sources, rows=rows, table=table)
-    write_json("bench_train", args.output, **payload)
+    common.write_json("bench_train", args.output, **payload)
 
 
 if __name__ == "__main__":

@@ -1,21 +1,14 @@
 """Generation on users' own corpora: lively, smooth and varied from one seed?
 
-Per content of Bandai dataset-2 (``bandai_dataset2``, takes 001-012 in one
-``--style``, default normal) and training seed: ``ConditionalRBM`` with the
-defaults (``--model`` changes them; sampler-only parameters are set after
-the cached fit) on the content's takes after ``make_motion_preprocessor``;
-4 sequences of 600 frames from the same real window (the one ending
-half-way through the first take); frames 300-599 judged against the real
-takes: *liveliness* of the 12 most-moving joint angles against the takes'
-middle halves (the cycle; *whole*: the whole takes), *divergence* of the 4
-(``metrics.divergence``: 0 copies, 1 unrelated), *jitter* of world joint
-positions (*body*: around the travelling root, *root*: its path), *skating*
-of the toes (locomotion), cycle *frequency*, *blown* (beyond twice the
-training data's largest |z|), *warned* (named by ``GenerationWarning``) and
-the fit's time.  Means over seeds with 95% bootstrap intervals; the JSON
-keeps every sequence.
-
-Run from the repository root (fitted models are cached)::
+Per content of Bandai dataset-2 (takes 001-012 in one ``--style``) and
+training seed: ``ConditionalRBM`` (``--model``; sampler-only parameters set
+after the cached fit) on the preprocessed takes; 4 sequences of 600 frames
+from the real window ending half-way through the first take, frames 300-599
+judged against the real takes: liveliness of the 12 most-moving angles
+(cycle: the takes' middle halves), divergence, jitter (body, root) and
+skating over the real, frequency, blown (|z| beyond twice the training
+data's), warned (``GenerationWarning``), fit time.  Means over seeds [95%
+bootstrap interval]; the JSON keeps every sequence::
 
     python benchmarks/corpora.py
     python benchmarks/corpora.py --contents run wave-both-hands --seeds 0 1
@@ -29,17 +22,9 @@ import time
 import warnings
 from pathlib import Path
 
+import _common as common
 import numpy as np
 import sklearn
-from _common import (
-    announce,
-    bootstrap_mean,
-    cached_fit,
-    parser,
-    print_table,
-    threadpool_limits,
-    write_json,
-)
 
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm.datasets import read_bvh_folder
@@ -70,8 +55,7 @@ SAMPLING_PARAMETERS = ("n_mean_field", "hidden_drift")
 
 
 class Content:
-    """The takes of one content and style, preprocessed, and the statistics
-    of the real ones."""
+    """The takes of one content and style, preprocessed, and their statistics."""
 
     def __init__(self, data_home, name, style="normal"):
         folder = Path(data_home) / "bandai_dataset2"
@@ -108,9 +92,8 @@ class Content:
         )
 
     def unscaled(self, Z):
-        """The joint angles and root channels, in their units (before scaling),
-        in the columns of ``Z`` (the scaler's inverse also restores the
-        constant channels it dropped)."""
+        """``Z``'s joint angles and root channels in their units (before scaling;
+        without the constant channels the scaler's inverse restores)."""
         scaler = self.preprocessor[-1]
         return scaler.inverse_transform(Z)[:, ~scaler.constant_mask_]
 
@@ -134,16 +117,14 @@ class Content:
         )
 
     def seed(self, width):
-        """``(N_SEQUENCES, width, n_features)``: the window that ends half-way
-        through the first take, once per sequence."""
+        """Per sequence, the ``width`` frames ending half-way through take one."""
         rows = np.flatnonzero(self.takes.sequence_ids == self.takes.sequence_ids[0])
         end = rows[len(rows) // 2]
         window = self.Z[end - width + 1 : end + 1]
         return np.repeat(window[None], N_SEQUENCES, axis=0)
 
     def cycle(self):
-        """Rows of the middle half of every take (the cycle, without the rest
-        or the transitions at its ends)."""
+        """Rows of the middle half of every take (the cycle, without its ends)."""
         ids = self.takes.sequence_ids
         rows = [np.flatnonzero(ids == take) for take in np.unique(ids)]
         return np.concatenate([r[len(r) // 4 : 3 * len(r) // 4] for r in rows])
@@ -156,8 +137,7 @@ def _travelling_joint(positions):
 
 
 def judge(content, model, seed, sample_params=None):
-    """Every statistic of the sequences that ``model`` generates (``sample``
-    given ``sample_params``)."""
+    """Every statistic of what ``model.sample(**sample_params)`` generates."""
     history = content.seed(max(model.history_length, 1))
     return describe(content, *generate(model, history, seed, sample_params))
 
@@ -174,8 +154,7 @@ def generate(model, history, seed, sample_params=None):
 
 
 def describe(content, Z, caught=(), sample_seconds=None):
-    """Every statistic of the generated ``Z`` (``N_SEQUENCES`` sequences of
-    ``N_FRAMES``) against the real takes of ``content``."""
+    """Every statistic of the generated ``Z`` against the takes of ``content``."""
     ids = np.repeat(np.arange(N_SEQUENCES), N_FRAMES)
     judged = np.tile(np.arange(N_FRAMES), N_SEQUENCES)
     judged = (judged >= JUDGED.start) & (judged < JUDGED.stop)
@@ -252,8 +231,7 @@ def summary_row(content, runs):
         if key not in runs[0]:
             continue
         per_seed = [np.nanmean(run[key]) for run in runs]
-        mean, low, high = bootstrap_mean(per_seed)
-        row[key] = f"{mean:.2f} [{low:.2f}, {high:.2f}]"
+        row[key] = common.interval_text(per_seed)
     row["blown"] = int(sum(np.sum(run["blown"]) for run in runs))
     row["warned"] = int(sum(np.sum(run["warned"]) for run in runs))
     row["fit"] = float(np.mean([run["fit_seconds"] for run in runs]))
@@ -265,18 +243,18 @@ def fitted_model(content, seed, model_params):
     fit_params = {k: v for k, v in model_params.items() if k not in SAMPLING_PARAMETERS}
     sampling = {k: v for k, v in model_params.items() if k in SAMPLING_PARAMETERS}
     model = ConditionalRBM(random_state=seed, **fit_params)
-    model, fit_seconds = cached_fit(model, content.Z, content.takes.sequence_ids)
+    model, fit_seconds = common.cached_fit(model, content.Z, content.takes.sequence_ids)
     return model.set_params(**sampling), fit_seconds
 
 
 def main(argv=None):
-    p = parser(__doc__)
+    p = common.parser(__doc__)
     p.add_argument("--contents", nargs="+", default=list(CYCLIC + ONE_SHOT))
     p.add_argument("--style", default="normal", help="the takes' style")
     p.add_argument("--model", default="{}", help="ConditionalRBM parameters, JSON")
     p.add_argument("--sample", default="{}", help="sample's parameters, JSON")
     args = p.parse_args(argv)
-    announce()
+    common.announce()
     model_params = json.loads(args.model)
     sample_params = json.loads(args.sample)
     rows, runs = [], {}
@@ -284,7 +262,7 @@ def main(argv=None):
         content = Content(args.data_home, name, args.style)
         runs[name] = []
         for seed in args.seeds:
-            with threadpool_limits(1):
+            with common.threadpool_limits(1):
                 start = time.perf_counter()
                 model, fit_seconds = fitted_model(content, seed, model_params)
                 run = judge(content, model, seed, sample_params)
@@ -292,22 +270,16 @@ def main(argv=None):
             runs[name].append(run)
             shown = (*STATISTICS, "blown", "warned")
             values = [f"{k} {np.round(run[k], 2).tolist()}" for k in shown if k in run]
+            values.append(f"fit {fit_seconds:.0f} s")
             seconds = time.perf_counter() - start
-            print(
-                f"  {name} seed {seed}: {', '.join(values)}, fit {fit_seconds:.0f} s "
-                f"({seconds:.0f} s)",
-                flush=True,
-            )
+            values = ", ".join(values)
+            print(f"  {name} seed {seed}: {values} ({seconds:.0f} s)", flush=True)
         rows.append(summary_row(name, runs[name]))
-    columns = [
-        "content",
-        "seeds",
-        *((key, f"{heading} [95%]", "s") for key, heading in STATISTICS.items()),
-        ("blown", "blown", "d"),
-        ("warned", "warned", "d"),
-        ("fit", "fit s", ".0f"),
-    ]
-    table = print_table(
+    columns = ["content", "seeds",
+               *((key, f"{heading} [95%]", "s") for key, heading in STATISTICS.items()),
+               ("blown", "blown", "d"), ("warned", "warned", "d"),
+               ("fit", "fit s", ".0f")]  # fmt: skip
+    table = common.print_table(
         rows,
         columns,
         title=f"\n{args.style} style, {N_SEQUENCES} sequences of {N_FRAMES} frames "
@@ -315,7 +287,7 @@ def main(argv=None):
         "judged; means over seeds [95% interval]",
     )
     payload = dict(args=vars(args), rows=rows, runs=runs, table=table)
-    write_json(f"corpora_{args.style}", args.output, **payload)
+    common.write_json(f"corpora_{args.style}", args.output, **payload)
     return rows
 
 

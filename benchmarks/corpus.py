@@ -1,24 +1,18 @@
 """One model of a whole labelled corpus (issue 47): any content in any style.
 
-Bandai dataset-2, takes 001-012 (``--contents``, ``--styles``).  Per
-training seed, ``FactoredCRBM`` (``--n-iter``, ``--model``) on takes
-001-010 of every cell but a Latin square held out (content ``i`` in style
-``i`` modulo the styles), content and style as two label factors
-(``--factors 1``: one label ``content/style``, none held out).  Our judge,
-a ``metrics.StyleJudge`` per factor on 2-s windows of the preprocessed
-takes 001-010 of every cell, has its accuracy on the real takes 011-012
-beside every figure.  Cells: 4 sequences of 600 frames from a normal walk,
-frames 300-599: windows judged the cell's content and style, sequences
-alive (liveliness against the cell's cycle >= 0.5) and ``corpora.py``'s
-statistics; raise-ups: the range of the cell's moving angles at least half
-the real takes' over frames 0-299 (action) and at most half over 300-599
-(rest).  Per content, switches at frame 300 of its content (into a
-held-out cell) and of its style (into a trained one): a window starting
-within 60 frames judged the new label, and the windows after.  Takes
-011-012: ``predict`` (``--recognise-frames``), log-likelihood per frame
-beside a ``ConditionalRBM`` per content (``--baseline``).  The fit's time
-and added peak memory; frames/s of one sequence, labels switching.  Means
-over seeds [95% bootstrap interval]; fits are cached::
+Bandai dataset-2, takes 001-010 of every ``--contents`` x ``--styles`` cell
+but a Latin square held out; per seed ``FactoredCRBM`` (``--n-iter``,
+``--model``) with content and style as two label factors (``--factors 1``:
+one label ``content/style``, none held out).  A ``StyleJudge`` per factor
+(its accuracy on the real takes 011-012 beside every figure) judges, per
+cell, 4 sequences of 600 frames from a normal walk over frames 300-599
+(content, style, alive, ``corpora.py``'s statistics; raise-ups: action then
+rest), and per content switches of content and of style at frame 300 (new
+label within 60 frames, and after).  Takes 011-012: ``predict``
+(``--recognise-frames``), log-likelihood per frame beside a
+``ConditionalRBM`` per content (``--baseline``).  Fit time and memory,
+frames/s with labels switching.  Means over seeds [95% bootstrap interval];
+fits are cached::
 
     python benchmarks/corpus.py
     python benchmarks/corpus.py --contents walk run --styles normal elderly \\
@@ -26,20 +20,12 @@ over seeds [95% bootstrap interval]; fits are cached::
 """
 
 import json
+from functools import partial
 from pathlib import Path
 
+import _common as common
 import numpy as np
 import sklearn
-from _common import (
-    announce,
-    bootstrap_mean,
-    cached_fit,
-    parser,
-    print_table,
-    threadpool_limits,
-    time_both,
-    write_json,
-)
 from corpora import CYCLIC, N_FRAMES, N_SEQUENCES, ONE_SHOT, Content, describe, generate
 from sklearn.utils import Bunch
 
@@ -105,8 +91,7 @@ class Corpus:
 
 
 class Judge:
-    """A ``StyleJudge`` of content and one of style on the 2-s windows of the
-    real takes 001-010 of every cell (held-out cells too)."""
+    """``StyleJudge``s of content and style on 2-s windows of every takes 001-010."""
 
     def __init__(self, corpus):
         ids, counts = np.unique(corpus.ids, return_counts=True)
@@ -128,8 +113,7 @@ class Judge:
             self.real[c, s] = (windows.content[cell] == c, windows.style[cell] == s)
 
     def windows(self, Z, ids=None):
-        """Every window's sequence id, first frame, and content and style
-        judged; ``ids`` None: sequences of ``N_FRAMES``."""
+        """Windows' sequence ids, starts, content and style (``ids``: N_FRAMES)."""
         if ids is None:
             ids = np.repeat(np.arange(len(Z) // N_FRAMES), N_FRAMES)
         Z = np.clip(np.nan_to_num(Z), -1e3, 1e3)  # what is left of a blow-up
@@ -219,12 +203,11 @@ def switches(corpus, judge, model, contents, styles, seed):
 
 
 def switching_speed(corpus, model, contents, styles):
-    """Frames per second of one sequence, its content changed every 100
-    frames and its style every 150, on one thread."""
+    """Frames/s of one sequence, content changed every 100 frames, style 150."""
     frames = np.arange(N_FRAMES)
     content = np.take(contents, frames // 100, mode="wrap")
     rows = np.column_stack([content, np.take(styles, frames // 150, mode="wrap")])
-    with threadpool_limits(1):
+    with common.threadpool_limits(1):
         return N_FRAMES / sequences(corpus, model, rows, 0, n_sequences=1)[2]
 
 
@@ -238,7 +221,8 @@ def recognition(corpus, model, n_frames):
     recognised (held-out cells' too), wall and CPU seconds."""
     rows = corpus.test & first_frames(corpus.ids, n_frames)
     X, ids, result = corpus.Z[rows], corpus.ids[rows], {}
-    wall, cpu = time_both(lambda: result.update(y=model.predict(X, sequence_ids=ids)))
+    predict = partial(model.predict, X, sequence_ids=ids)
+    wall, cpu = common.time_both(lambda: result.update(y=predict()))
     first = np.r_[True, ids[1:] != ids[:-1]]
     predicted = result["y"][first]
     if corpus.factors == 1:
@@ -259,7 +243,7 @@ def likelihood(corpus, model, seed, baseline_params):
     for content in np.unique(corpus.content):
         base = ConditionalRBM(random_state=seed, **baseline_params)
         train = corpus.train & (corpus.content == content)
-        base = cached_fit(base, corpus.Z[train], corpus.ids[train])[0]
+        base = common.cached_fit(base, corpus.Z[train], corpus.ids[train])[0]
         width = max(model.history_length, base.history_length)
         for unseen in (False, True):
             rows = corpus.test & (corpus.content == content) & (corpus.unseen == unseen)
@@ -286,10 +270,11 @@ def one_seed(corpus, judge, seed, args):
     if args.n_iter is not None:
         params["n_iter"] = args.n_iter
     X, ids, y = (f[corpus.train] for f in (corpus.Z, corpus.ids, corpus.labels(...)))
-    with threadpool_limits(args.threads):
-        model, *fit = cached_fit(FactoredCRBM(**params), X, ids, y=y, memory=True)
+    with common.threadpool_limits(args.threads):
+        model = FactoredCRBM(**params)
+        model, *fit = common.cached_fit(model, X, ids, y=y, memory=True)
     run = dict(seed=seed, n_iter=model.n_iter_, cells={})
-    with threadpool_limits(1):
+    with common.threadpool_limits(1):
         for cell in [(c, s) for c in args.contents for s in args.styles]:
             run["cells"]["/".join(cell)] = judge_cell(corpus, judge, model, cell, seed)
             shown = {k: np.mean(v) for k, v in run["cells"]["/".join(cell)].items()}
@@ -320,12 +305,10 @@ def one_seed(corpus, judge, seed, args):
 
 
 def interval(per_seed, percent=False):
-    """Mean over seeds and its 95% bootstrap interval, as text."""
+    """Mean over seeds [95% interval] as text; "-" where a seed has none."""
     if any(value is None or np.isnan(value) for value in per_seed):
         return "-"
-    scale, spec = (100, ".0f") if percent else (1, ".2f")
-    mean, low, high = (scale * v for v in bootstrap_mean(per_seed))
-    return f"{mean:{spec}}{'%' if percent else ''} [{low:{spec}}, {high:{spec}}]"
+    return common.interval_text(per_seed, percent)
 
 
 PERCENT = ("content", "style", "alive", "action", "rest")
@@ -345,7 +328,7 @@ def cell_row(name, runs, cells, judge):
 
 
 def main(argv=None):
-    p = parser(__doc__, seeds=(0, 1, 2))
+    p = common.parser(__doc__, seeds=(0, 1, 2))
     p.add_argument("--contents", nargs="+", default=list(CYCLIC + ONE_SHOT))
     p.add_argument("--styles", nargs="+", default=list(STYLES))
     p.add_argument("--factors", type=int, choices=(1, 2), default=2)
@@ -357,7 +340,7 @@ def main(argv=None):
     args = p.parse_args(argv)
     if min(len(args.contents), len(args.styles)) < 2:
         p.error("give at least two contents and two styles")
-    announce()
+    common.announce()
     cells = [(c, s) for c in args.contents for s in args.styles]
     styles = args.styles * len(args.contents)  # a Latin square, if two factors
     held_out = (
@@ -400,18 +383,17 @@ def main(argv=None):
         "judge on real: its content / style accuracy on the cells' takes 011-012"
     )
     tables = [
-        print_table(groups, columns, title=title),
-        print_table(per_cell, columns, title="\nper cell"),
-        print_table(
+        common.print_table(groups, columns, title=title),
+        common.print_table(per_cell, columns, title="\nper cell"),
+        common.print_table(
             others,
             ["measure", ("value", "mean [95%]", "s"), ("judge", "judge on real", "s")],
             title=f"\nthe judge on all real windows of takes 011-012: {real}; {data}",
         ),
     ]
-    payload = dict(held_out=held_out, groups=groups, cells=per_cell, others=others)
-    write_json(
-        "corpus", args.output, args=vars(args), runs=runs, tables=tables, **payload
-    )
+    payload = dict(args=vars(args), runs=runs, tables=tables, held_out=held_out)
+    payload.update(groups=groups, cells=per_cell, others=others)
+    common.write_json("corpus", args.output, **payload)
 
 
 if __name__ == "__main__":

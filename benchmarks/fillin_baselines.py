@@ -18,40 +18,26 @@ Run from the repository root (fitted models are cached)::
 
 import json
 
+import _common as common
 import numpy as np
-from _common import (
-    CELLS,
-    SPLITS,
-    Split,
-    announce,
-    crbm_imputer,
-    fill_errors,
-    fitted_baselines,
-    log_ratio_columns,
-    log_ratio_row,
-    parser,
-    print_errors,
-    print_table,
-    write_json,
-)
 
 
 def measure(split, seeds, model_params, imputer_params):
     """The errors of the baselines and of the CRBM of every seed, by cell."""
     X = split.X_train.astype(np.float32)
-    base = fill_errors(fitted_baselines(X, split.train_ids), split.cases)
+    base = common.fill_errors(common.fitted_baselines(X, split.train_ids), split.cases)
     crbm = {}
     for seed in seeds:
-        imputer, seconds = crbm_imputer(
+        imputer, seconds = common.crbm_imputer(
             X, split.train_ids, seed, model_params, imputer_params
         )
-        crbm[seed] = fill_errors({seed: imputer}, split.cases)[seed]
+        crbm[seed] = common.fill_errors({seed: imputer}, split.cases)[seed]
         print(f"  {split.name} seed {seed}: fitted in {seconds:.0f} s", flush=True)
     return base, crbm
 
 
 def errors_by_method(base, crbm):
-    best = {c: min(row[c] for row in base.values()) for c in CELLS}
+    best = {c: min(row[c] for row in base.values()) for c in common.CELLS}
     seeds = {f"CRBM, seed {seed}": row for seed, row in crbm.items()}
     return {**base, "best baseline": best, **seeds}
 
@@ -61,42 +47,43 @@ def log_ratio_rows(results):
     rows, pooled = [], []
     for split, (base, crbm) in results.items():
         seeds = sorted(crbm)
-        for cell in CELLS:
+        for cell in common.CELLS:
             best = min(row[cell] for row in base.values())
             ratios = np.log([crbm[s][cell] / best for s in seeds])
             pooled.append(ratios)
-            rows.append(log_ratio_row(f"{split} {cell}", ratios))
-    rows.append(log_ratio_row("all cells", np.array(pooled).T))
+            rows.append(common.log_ratio_row(f"{split} {cell}", ratios))
+    rows.append(common.log_ratio_row("all cells", np.array(pooled).T))
     return rows
 
 
 def main(argv=None):
-    p = parser(__doc__)
-    p.add_argument("--splits", nargs="+", default=list(SPLITS), choices=SPLITS)
+    p = common.parser(__doc__)
+    splits = common.SPLITS
+    p.add_argument("--splits", nargs="+", default=[*splits], choices=splits)
     p.add_argument("--model", default="{}", help="ConditionalRBM parameters, JSON")
     p.add_argument("--imputer", default="{}", help="CRBMImputer parameters, JSON")
     args = p.parse_args(argv)
-    announce()
+    common.announce()
     model_params, imputer_params = json.loads(args.model), json.loads(args.imputer)
     results = {}
     for name in args.splits:
-        split = Split(args.data_home, name)
+        split = common.Split(args.data_home, name)
         results[name] = measure(split, args.seeds, model_params, imputer_params)
-        print_errors(
+        common.print_errors(
             errors_by_method(*results[name]),
             f"\nSplit {name} ({', '.join(split.trials)} held out): the paper's "
             "error, lower is better",
             with_paper=name == "paper",
         )
     ratios = log_ratio_rows(results)
-    table = print_table(
+    table = common.print_table(
         ratios,
-        log_ratio_columns(),
+        common.log_ratio_columns(),
         title="\nCRBM against the best baseline, over seeds",
     )
     splits = {name: dict(baselines=b, crbm=c) for name, (b, c) in results.items()}
     payload = dict(args=vars(args), splits=splits, log_ratios=ratios, table=table)
-    write_json("fillin_baselines", args.output, **payload)
+    common.write_json("fillin_baselines", args.output, **payload)
     return ratios
 
 

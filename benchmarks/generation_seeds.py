@@ -18,22 +18,14 @@ Run from the repository root (fitted models are cached)::
 
 import json
 
+import _common as common
 import numpy as np
 import sklearn
-from _common import (
-    PAPER_ENCODING,
-    MotionCorpus,
-    announce,
-    cached_fit,
-    parser,
-    print_table,
-    write_json,
-)
 
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm.metrics import divergence, jitter
 
-ENCODINGS = {"paper": PAPER_ENCODING, "default": {}}
+ENCODINGS = {"paper": common.PAPER_ENCODING, "default": {}}
 STYLES = ("walk", "jog")
 N_PER_STYLE = 6
 WINDOWS = {"200-299": 300, "900-999": 1000}  # frames judged -> their end
@@ -91,7 +83,7 @@ def from_one_seed(corpus, model, history, seed_styles, seed):
 
 def generate_and_judge(corpus, seed, model_params):
     model = ConditionalRBM(random_state=seed, **model_params)
-    model, _ = cached_fit(model, corpus.Z.astype(np.float32), corpus.ids)
+    model, _ = common.cached_fit(model, corpus.Z.astype(np.float32), corpus.ids)
     history, seed_styles = corpus.seed_windows(model, N_PER_STYLE, seed)
     n_frames = max(WINDOWS.values())
     generated = model.sample(n_frames, history=history, random_state=seed)
@@ -108,15 +100,15 @@ def generate_and_judge(corpus, seed, model_params):
 
 
 def main(argv=None):
-    p = parser(__doc__)
+    p = common.parser(__doc__)
     p.add_argument("--encodings", nargs="+", default=list(ENCODINGS), choices=ENCODINGS)
     p.add_argument("--model", default="{}", help="ConditionalRBM parameters, JSON")
     args = p.parse_args(argv)
-    announce()
+    common.announce()
     model_params = json.loads(args.model)
     rows, details = [], {}
     for encoding in args.encodings:
-        corpus = MotionCorpus(args.data_home, "cmu", ENCODINGS[encoding])
+        corpus = common.MotionCorpus(args.data_home, "cmu", ENCODINGS[encoding])
         for seed in args.seeds:
             row, details[f"{encoding} {seed}"] = generate_and_judge(
                 corpus, seed, model_params
@@ -125,23 +117,15 @@ def main(argv=None):
             print(f"  {encoding} seed {seed}: {row}", flush=True)
     cells = [f"{s} {w}" for w in WINDOWS for s in STYLES]
     total = sum(row[cell] for row in rows for cell in cells)
-    columns = (
-        ["encoding", "seed"]
-        + [(cell, f"{cell.replace(' ', 's pass, frames ')}", "d") for cell in cells]
-        + [
-            (f"{style} {key}", f"{style}: {key} from one seed", ".2f")
-            for style in STYLES
-            for key in ("divergence", "jitter")
-        ]
-    )
-    table = print_table(
-        rows,
-        columns,
-        title=f"\nSequences passing (of {N_PER_STYLE} per cell): "
-        f"{total} of {len(rows) * len(cells) * N_PER_STYLE} windows",
-    )
+    passing = [(c, c.replace(" ", "s pass, frames "), "d") for c in cells]
+    one_seed = [(f"{s} {k}", f"{s}: {k} from one seed", ".2f")
+                for s in STYLES for k in ("divergence", "jitter")]  # fmt: skip
+    windows = f"{total} of {len(rows) * len(cells) * N_PER_STYLE} windows"
+    title = f"\nSequences passing (of {N_PER_STYLE} per cell): {windows}"
+    columns = ["encoding", "seed", *passing, *one_seed]
+    table = common.print_table(rows, columns, title=title)
     payload = dict(args=vars(args), rows=rows, passing=total, sequences=details)
-    write_json("generation_seeds", args.output, **payload, table=table)
+    common.write_json("generation_seeds", args.output, **payload, table=table)
     return rows
 
 

@@ -15,17 +15,8 @@ Run from the repository root (models shared with ``fillin_baselines.py``)::
 
 import copy
 
+import _common as common
 import numpy as np
-from _common import (
-    SPLITS,
-    Split,
-    announce,
-    cached_fit,
-    frames_with_history,
-    parser,
-    print_table,
-    write_json,
-)
 from scipy.stats import multivariate_normal
 
 from sklearn_crbm import ConditionalRBM
@@ -79,15 +70,16 @@ def crbm_scores(model, X, ids, frames):
 
 
 def main(argv=None):
-    p = parser(__doc__)
-    p.add_argument("--splits", nargs="+", default=list(SPLITS), choices=SPLITS)
+    p = common.parser(__doc__)
+    splits = common.SPLITS
+    p.add_argument("--splits", nargs="+", default=[*splits], choices=splits)
     p.add_argument("--ais", type=int, nargs=2, metavar=("STEPS", "CHAINS"))
     args = p.parse_args(argv)
-    announce()
+    common.announce()
     results, rows = {}, []
     for name in args.splits:
-        split = Split(args.data_home, name)
-        frames = frames_with_history(split.test_ids, ORDER)
+        split = common.Split(args.data_home, name)
+        frames = common.frames_with_history(split.test_ids, ORDER)
         X_train, X_test = (X.astype(np.float32) for X in (split.X_train, split.X_test))
         ar = ar_log_likelihoods(split, frames)
         rows += [dict(split=name, model=model, mean=v) for model, v in ar.items()]
@@ -95,7 +87,7 @@ def main(argv=None):
         for model_name, params in MODELS.items():
             for seed in args.seeds:
                 model = ConditionalRBM(random_state=seed, **params)
-                model, _ = cached_fit(model, X_train, split.train_ids)
+                model, _ = common.cached_fit(model, X_train, split.train_ids)
                 if args.ais:
                     model.set_params(ais_steps=args.ais[0], ais_chains=args.ais[1])
                 scores = crbm_scores(model, X_test, split.test_ids, frames)
@@ -103,21 +95,14 @@ def main(argv=None):
                 print(f"  {name} {model_name} seed {seed}: {scores}", flush=True)
             rows.append(seed_summary(name, model_name, crbm[model_name]))
         results[name] = dict(n_frames=len(frames), ar=ar, crbm=crbm)
-    table = print_table(
-        rows,
-        [
-            "split",
-            "model",
-            ("mean", "mean over seeds", ".2f"),
-            ("low", "lowest seed", ".2f"),
-            ("high", "highest seed", ".2f"),
-            ("gap", "forward - reverse, largest", ".3f"),
-            ("without_hidden", "without hidden units", ".2f"),
-        ],
-        title="\nHeld-out log p(x_t | past), nats per frame (forward annealing)",
-    )
+    columns = ["split", "model", ("mean", "mean over seeds", ".2f"),
+               ("low", "lowest seed", ".2f"), ("high", "highest seed", ".2f"),
+               ("gap", "forward - reverse, largest", ".3f"),
+               ("without_hidden", "without hidden units", ".2f")]  # fmt: skip
+    title = "\nHeld-out log p(x_t | past), nats per frame (forward annealing)"
+    table = common.print_table(rows, columns, title=title)
     payload = dict(args=vars(args), splits=results, table=table)
-    write_json("likelihood_baselines", args.output, **payload)
+    common.write_json("likelihood_baselines", args.output, **payload)
     return rows
 
 

@@ -15,20 +15,8 @@ Run from the repository root (fitted models are cached)::
     python benchmarks/paper_fillin.py --variants defaults --seeds 0 --n-repeats 10
 """
 
+import _common as common
 import numpy as np
-from _common import (
-    CELLS,
-    Split,
-    announce,
-    cached_fit,
-    frozen_imputer,
-    log_ratio_columns,
-    log_ratio_row,
-    parser,
-    print_errors,
-    print_table,
-    write_json,
-)
 from sklearn.experimental import enable_iterative_imputer  # noqa: F401
 from sklearn.impute import IterativeImputer, KNNImputer
 
@@ -54,8 +42,9 @@ def baselines(X):
 def crbm_scores(split, variant, seed, n_repeats):
     make_model, imputer_params = VARIANTS[variant]
     X = split.X_train.astype(np.float32)
-    model, seconds = cached_fit(make_model(random_state=seed), X, split.train_ids)
-    imputer = frozen_imputer(model, X, split.train_ids, seed, **imputer_params)
+    model = make_model(random_state=seed)
+    model, seconds = common.cached_fit(model, X, split.train_ids)
+    imputer = common.frozen_imputer(model, X, split.train_ids, seed, **imputer_params)
     print(f"  {variant} seed {seed}: fitted in {seconds:.0f} s", flush=True)
     scores = compare_imputers(
         {0: imputer}, split.cases, n_repeats=n_repeats, random_state=seed
@@ -64,14 +53,16 @@ def crbm_scores(split, variant, seed, n_repeats):
 
 
 def main(argv=None):
-    p = parser(__doc__)
+    p = common.parser(__doc__)
     p.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=VARIANTS)
     p.add_argument("--n-repeats", type=int, default=100, help="single draws")
     args = p.parse_args(argv)
-    announce()
-    split = Split(args.data_home, "paper")
+    common.announce()
+    split = common.Split(args.data_home, "paper")
     base = compare_imputers(baselines(split.X_train), split.cases)
-    errors = {name: {c: s[c]["error"] for c in CELLS} for name, s in base.items()}
+    errors = {
+        name: {c: s[c]["error"] for c in common.CELLS} for name, s in base.items()
+    }
     crbm = {
         v: {s: crbm_scores(split, v, s, args.n_repeats) for s in args.seeds}
         for v in args.variants
@@ -80,25 +71,27 @@ def main(argv=None):
     summary = []
     for variant, per_seed in crbm.items():
         for seed, scores in per_seed.items():
-            errors[f"{variant}, seed {seed}"] = {c: scores[c]["error"] for c in CELLS}
-        for cell in CELLS:
+            errors[f"{variant}, seed {seed}"] = {
+                c: scores[c]["error"] for c in common.CELLS
+            }
+        for cell in common.CELLS:
             log_ratios = [
                 np.log(s[cell]["error"] / nearest[cell]["error"])
                 for s in per_seed.values()
             ]
-            summary.append(log_ratio_row(f"{variant}, {cell}", log_ratios))
-    print_errors(
+            summary.append(common.log_ratio_row(f"{variant}, {cell}", log_ratios))
+    common.print_errors(
         errors,
         "\nThe paper's error (CRBM: mean of single draws), lower is better",
         with_paper=True,
     )
-    table = print_table(
+    table = common.print_table(
         summary,
-        log_ratio_columns("nearest neighbour"),
+        common.log_ratio_columns("nearest neighbour"),
         title="\nCRBM against the paper's baseline, over seeds",
     )
     payload = dict(args=vars(args), baselines=base, crbm=crbm, summary=summary)
-    write_json("paper_fillin", args.output, **payload, table=table)
+    common.write_json("paper_fillin", args.output, **payload, table=table)
 
 
 if __name__ == "__main__":

@@ -16,8 +16,8 @@ Run from the repository root::
     python benchmarks/paper_generation.py --parts transitions --noise 0 2 4
 """
 
+import _common as common
 import numpy as np
-from _common import MotionCorpus, announce, cached_fit, parser, print_table, write_json
 
 from sklearn_crbm import ConditionalRBM, StackedCRBM
 
@@ -39,7 +39,7 @@ PARTS, DATASETS = ("styles", "transitions"), ("cmu", "mit")
 
 def fitted(corpus, model_name, seed):
     model = MODELS[model_name](seed)
-    return cached_fit(model, corpus.Z.astype(np.float32), corpus.ids)[0]
+    return common.cached_fit(model, corpus.Z.astype(np.float32), corpus.ids)[0]
 
 
 def styles_row(corpus, model, seed):
@@ -92,14 +92,14 @@ def transitions_row(corpus, model, seed, noise, n_frames=1200):
 
 
 def main(argv=None):
-    p = parser(__doc__, seeds=(0, 1, 2))
+    p = common.parser(__doc__, seeds=(0, 1, 2))
     p.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
     p.add_argument("--datasets", nargs="+", default=list(DATASETS), choices=DATASETS)
     p.add_argument("--models", nargs="+", default=list(MODELS), choices=MODELS)
     p.add_argument("--noise", type=float, nargs="+", default=[0, 1, 2, 2.5, 3, 4])
     args = p.parse_args(argv)
-    announce()
-    corpora = {name: MotionCorpus(args.data_home, name) for name in args.datasets}
+    common.announce()
+    corpora = {n: common.MotionCorpus(args.data_home, n) for n in args.datasets}
     results = {}
     if "styles" in args.parts:
         rows = []
@@ -118,10 +118,10 @@ def main(argv=None):
                 (f"{style} {k}", f"{style} {k}", ".2f") for k in ("speed", "Hz")
             ]
         title = f"\n§4.1, §5: {N_PER_STYLE} sequences per style, last 100 of {N_FRAMES} frames"
-        table = print_table(rows, [*columns, "passes"], title=title)
+        table = common.print_table(rows, [*columns, "passes"], title=title)
         results["styles"] = dict(rows=rows, table=table)
     if "transitions" in args.parts:
-        corpus = corpora.get("cmu") or MotionCorpus(args.data_home, "cmu")
+        corpus = corpora.get("cmu") or common.MotionCorpus(args.data_home, "cmu")
         rows = [
             transitions_row(corpus, fitted(corpus, "defaults", seed), seed, noise)
             for noise in args.noise
@@ -133,9 +133,9 @@ def main(argv=None):
         title = (
             f"\n§4.3: {2 * N_PER_STYLE} sequences of 1200 frames, windows of {WINDOW}"
         )
-        table = print_table(rows, columns, title=title)
+        table = common.print_table(rows, columns, title=title)
         results["transitions"] = dict(rows=rows, table=table)
-    write_json("paper_generation", args.output, args=vars(args), **results)
+    common.write_json("paper_generation", args.output, args=vars(args), **results)
 
 
 if __name__ == "__main__":

@@ -18,17 +18,9 @@ Run from the repository root (fitted models are cached)::
 import json
 import warnings
 
+import _common as common
 import numpy as np
 import sklearn
-from _common import (
-    MotionCorpus,
-    announce,
-    bootstrap_mean,
-    cached_fit,
-    parser,
-    print_table,
-    write_json,
-)
 
 from sklearn_crbm import ConditionalRBM
 from sklearn_crbm.exceptions import GenerationWarning
@@ -46,7 +38,7 @@ class SpeedTask:
     """CMU 35 with every frame's forward speed, and the requests to generate."""
 
     def __init__(self, data_home):
-        self.corpus = corpus = MotionCorpus(data_home, "cmu")
+        self.corpus = corpus = common.MotionCorpus(data_home, "cmu")
         data = corpus.data
         self.speed = MotionContext(
             data.skeleton, signals=["forward_speed"], frame_rate=data.frame_rate
@@ -76,7 +68,7 @@ class SpeedTask:
         """``(model, fit seconds)``: the model trained with every frame's speed."""
         model = ConditionalRBM(random_state=seed, **model_params)
         context = np.asarray(self.speeds, dtype=float).reshape(-1, 1)
-        return cached_fit(model, self.corpus.Z, self.corpus.ids, context=context)
+        return common.cached_fit(model, self.corpus.Z, self.corpus.ids, context=context)
 
     def generate(self, model, history, speed, seed):
         """``(Z, raw speed per frame)`` of sequences generated at ``speed``."""
@@ -141,7 +133,7 @@ def measure_seed(task, seed, model_params, n_sequences):
 def interval(per_seed, key):
     """Mean over seeds (of each seed's mean over sequences) and its interval."""
     values = [np.mean(result[key]) for result in per_seed]
-    return bootstrap_mean(values)
+    return common.bootstrap_mean(values)
 
 
 def summary_row(name, per_seed, task):
@@ -150,63 +142,43 @@ def summary_row(name, per_seed, task):
     blown = sum(int(np.sum(r["blown"])) for r in per_seed)
     n = sum(len(r["alive"]) for r in per_seed)
     amplitude = interval(per_seed, "amplitude")
-    row = dict(
-        request=name,
-        amplitude=amplitude[0],
-        amplitude_ci=f"{amplitude[1]:.2f}-{amplitude[2]:.2f}",
-        alive=f"{alive} of {n}",
-        blown=f"{blown} of {n}",
-    )
+    row = dict(request=name, amplitude=amplitude[0],
+               amplitude_ci=f"{amplitude[1]:.2f}-{amplitude[2]:.2f}",
+               alive=f"{alive} of {n}", blown=f"{blown} of {n}")  # fmt: skip
     lively = abs(amplitude[0] - 1) <= AMPLITUDE_TOLERANCE and blown == 0
     if name == "ramp":
         correlation = interval(per_seed, "correlation")
-        row.update(
-            requested=f"{task.walk:.1f} to {task.jog:.1f}",
-            correlation=correlation[0],
-            ci=f"{correlation[1]:.3f}-{correlation[2]:.3f}",
-            met=lively and correlation[0] >= CORRELATION_TARGET,
-        )
+        row.update(requested=f"{task.walk:.1f} to {task.jog:.1f}",
+                   correlation=correlation[0],
+                   ci=f"{correlation[1]:.3f}-{correlation[2]:.3f}",
+                   met=lively and correlation[0] >= CORRELATION_TARGET)  # fmt: skip
     else:
         speed, error = interval(per_seed, "speed"), interval(per_seed, "error")
-        row.update(
-            requested=f"{per_seed[0]['requested']:.1f}",
-            speed=speed[0],
-            speed_ci=f"{speed[1]:.1f}-{speed[2]:.1f}",
-            error=error[0],
-            ci=f"{error[1]:+.3f} to {error[2]:+.3f}",
-            met=lively and abs(error[0]) <= ERROR_TARGET,
-        )
+        row.update(requested=f"{per_seed[0]['requested']:.1f}", speed=speed[0],
+                   speed_ci=f"{speed[1]:.1f}-{speed[2]:.1f}", error=error[0],
+                   ci=f"{error[1]:+.3f} to {error[2]:+.3f}",
+                   met=lively and abs(error[0]) <= ERROR_TARGET)  # fmt: skip
     row["met"] = "yes" if row["met"] else "no"
     return row
 
 
-COLUMNS = [
-    "request",
-    ("requested", "requested units/s", "s"),
-    ("speed", "generated", ".1f"),
-    ("speed_ci", "95%", "s"),
-    ("error", "error / (jog - walk)", "+.3f"),
-    ("correlation", "ramp correlation", ".3f"),
-    ("ci", "95%", "s"),
-    ("amplitude", "leg amplitude / real", ".2f"),
-    ("amplitude_ci", "95%", "s"),
-    "alive",
-    "blown",
-    "met",
-]
+COLUMNS = ["request", ("requested", "requested units/s", "s"),
+           ("speed", "generated", ".1f"), ("speed_ci", "95%", "s"),
+           ("error", "error / (jog - walk)", "+.3f"),
+           ("correlation", "ramp correlation", ".3f"), ("ci", "95%", "s"),
+           ("amplitude", "leg amplitude / real", ".2f"),
+           ("amplitude_ci", "95%", "s"), "alive", "blown", "met"]  # fmt: skip
 
 
 def main(argv=None):
-    p = parser(__doc__)
+    p = common.parser(__doc__)
     p.add_argument("--model", default="{}", help="ConditionalRBM parameters, JSON")
     p.add_argument("--n-sequences", type=int, default=6, help="per request")
     args = p.parse_args(argv)
-    announce()
+    common.announce()
     task = SpeedTask(args.data_home)
-    print(
-        f"real forward speed (units/s): walks {task.walk:.1f}, jogs {task.jog:.1f}",
-        flush=True,
-    )
+    speeds = f"walks {task.walk:.1f}, jogs {task.jog:.1f}"
+    print(f"real forward speed (units/s): {speeds}", flush=True)
     model_params = json.loads(args.model)
     per_seed = {}
     for seed in args.seeds:
@@ -216,7 +188,7 @@ def main(argv=None):
     rows = [
         summary_row(name, [r[name] for r in per_seed.values()], task) for name in names
     ]
-    table = print_table(
+    table = common.print_table(
         rows,
         COLUMNS,
         title=f"\nSpeed control, seeds "
@@ -230,7 +202,7 @@ def main(argv=None):
         rows=rows,
         seeds={str(seed): result for seed, result in per_seed.items()},
     )
-    write_json("speed_control", args.output, **payload, table=table)
+    common.write_json("speed_control", args.output, **payload, table=table)
     return rows
 
 

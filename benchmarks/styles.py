@@ -1,24 +1,18 @@
 """Many styles from one model: the factored CRBM's criteria (issues 29, 35).
 
-The Bandai walks in seven styles (``load_bandai_walks``, 30 frames per
-second), the default ``make_motion_preprocessor`` fitted on takes 001-005;
-the takes 006 are held out.  ``FactoredCRBM`` with the defaults per seed of
-``--seeds`` (``--n-iter`` shortens training).  Parts (``--parts``):
+The Bandai walks in seven styles, preprocessed as fitted on takes 001-005;
+the takes 006 held out.  ``FactoredCRBM`` with the defaults per seed
+(``--n-iter`` shortens training).  Parts (``--parts``): ``style`` (per style,
+``--n-sequences`` x ``--n-frames`` frames from a normal walk, windows from
+frame 100 judged the style and alive, gait within 25%/15%, no blow-up),
+``blends`` (the 21 pairs at 50/50), ``transitions`` (the 42 ordered pairs
+switched half-way, judged 60 frames on), ``likelihood``, ``recognition`` and
+``fillin`` (log ratio to the best of ``KNNImputer`` (5, 10) and
+``AutoregressiveImputer``) on the takes 006, ``speed`` (s/epoch; the
+products' share of generating 100 sequences together, at least 0.6).
 
-``style``: per style, ``--n-sequences`` x ``--n-frames`` frames from a
-normal walk; 2-s windows from frame 100 judged the style and alive
-(``StyleJudge``), gait within 25%/15% of the style's, no blow-up.
-``blends``: the 21 pairs at 50/50, judged one of the two, speed and step
-frequency between the two.  ``transitions``: the 42 ordered pairs switched
-half-way, judged the new style 60 frames on.  ``likelihood``: held-out
-log-likelihood per frame of the takes 006.  ``recognition``: ``predict`` on
-every take 006.  ``fillin``: left leg or upper body of every take 006 from
-half-way, mean log ratio to the best of ``KNNImputer`` (5, 10) and
-``AutoregressiveImputer``.  ``speed``: seconds per epoch; the products'
-share of generating 100 sequences together (at least 0.6).
-
-Run from the repository root; results are cached per seed, keyed by the
-code, and ``--tabulate`` merges earlier runs' JSON (seeds run apart)::
+Results are cached per seed, keyed by the code; ``--tabulate`` merges
+earlier runs' JSON (seeds run apart)::
 
     python benchmarks/styles.py --seeds 0 --n-iter 50
     python benchmarks/styles.py --tabulate seed0.json seed1.json
@@ -37,19 +31,9 @@ import json  # noqa: E402
 from functools import partial  # noqa: E402
 from pathlib import Path  # noqa: E402
 
+import _common as common  # noqa: E402
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
-from _common import (  # noqa: E402
-    CACHE,
-    PACKAGE,
-    RESULTS,
-    bootstrap_mean,
-    frames_with_history,
-    frozen_imputer,
-    parser,
-    print_table,
-    seconds,
-)
 from sklearn.impute import KNNImputer  # noqa: E402
 
 from sklearn_crbm import FactoredCRBM  # noqa: E402
@@ -75,16 +59,10 @@ PARTS = tuple("style blends transitions likelihood recognition fillin speed".spl
 
 # ------------------------------------------------------------------- data
 class Split:
-    """One split of ``walks``, preprocessed, with the instruments that judge motion.
-
-    ``train`` and ``test`` are masks of the frames (rows of ``walks.data``);
-    ``Z`` is every take preprocessed; ``styles`` are the style names in the
-    order of the label weights; ``judge`` calls the style of 2-s windows and
-    whether they are alive, ``pace`` gives the amplitude and frequency of
-    100-frame windows against the real ones; ``limit`` is the |z| per channel
-    beyond which motion has blown up; ``real_speed`` and ``real_frequency``
-    (Hz) are the means of the real takes of every style.
-    """
+    """``walks`` preprocessed (``Z``) as fitted on the ``train`` frames, with
+    ``judge`` (2-s windows' style, alive), ``pace`` (100 frames' gait), ``limit``
+    (|z| per channel beyond which motion blew up) and the real takes' mean
+    speed and step frequency per style (``styles``: the label weights' order)."""
 
     def __init__(self, walks, train):
         self.walks, self.train, self.test = walks, train, ~train
@@ -264,7 +242,7 @@ def likelihood(model, split, seed):
     result = model.estimate_log_likelihood(
         Z, sequence_ids=ids, style=styles, reverse=True, random_state=seed
     )
-    scored = frames_with_history(ids, SCORED_FROM)
+    scored = common.frames_with_history(ids, SCORED_FROM)
     estimate, error = result.log_likelihood[scored], result.standard_error[scored]
     return dict(
         mean=float(estimate.mean()),
@@ -314,23 +292,22 @@ def fillin(model, split, seed):
     for (style, part), case in cases.items():
         best = min(case.errors(b.transform(case.X_missing))[0] for b in baselines)
         if style not in imputers:
-            imputers[style] = frozen_imputer(model, Z, ids, seed, train_styles)
+            imputers[style] = common.frozen_imputer(model, Z, ids, seed, train_styles)
         filled = imputers[style].transform(case.X_missing, style=style)
         ratios[f"{style}/{part}"] = float(np.log(case.errors(filled)[0] / best))
     return ratios
 
 
 def speed(model, split, fit_seconds, rng, n_sequences=100, n_frames=30):
-    """Seconds per epoch; frames per second of ``n_sequences`` generated
-    together against the bound set by their matrix products alone (the
-    batch criterion: at least 0.6 of it)."""
+    """Seconds per epoch; frames/s of ``n_sequences`` generated together over
+    the bound of their matrix products alone (criterion: at least 0.6)."""
     weights = label_weights(split.styles, n_frames, NORMAL)
     history = split.seed_windows(NORMAL, model.history_length, n_sequences, rng)
     run = partial(
         model.sample, n_frames, history=history, style=weights, random_state=0
     )
     shapes = _recorded_products(run)
-    generation, alone = seconds(run), seconds(_products_alone(shapes))
+    generation, alone = common.seconds(run), common.seconds(_products_alone(shapes))
     return dict(
         seconds_per_epoch=fit_seconds / model.n_iter_,
         generation_seconds=generation,
@@ -380,35 +357,29 @@ ONE_CELL_PARTS = ("likelihood", "recognition", "speed")
 
 def _per_seed(results, part):
     """``part``'s cells of every seed that has it: a list (one per seed) of lists."""
-    rows = []
-    for result in results.values():
-        found = result.get(part)
-        if found is not None:
-            rows.append([found] if part in ONE_CELL_PARTS else list(found.values()))
-    return rows
+    found = [r[part] for r in results.values() if r.get(part) is not None]
+    return [[f] if part in ONE_CELL_PARTS else list(f.values()) for f in found]
 
 
-def _interval(rows, key, rng, percent=True):
-    """Mean of ``key`` of the cells (None: the cells) over the seeds, with its
-    95% bootstrap interval."""
+def _cells(rows, key):
+    return [cell[key] for row in rows for cell in row]
+
+
+def _interval(rows, rng, key=None, percent=True):
+    """Mean of ``key`` of the cells (None: the cells) over the seeds [95%]."""
     values = [[cell if key is None else cell[key] for cell in row] for row in rows]
-    mean, low, high = bootstrap_mean(values, seed=rng)
-    if percent:
-        return f"{100 * mean:.0f}% [{100 * low:.0f}, {100 * high:.0f}]"
-    return f"{mean:+.3f} [{low:+.3f}, {high:+.3f}]"
+    return common.interval_text(values, percent, "+.3f", rng)
 
 
 def _fillin(rows, rng):
     """Mean log ratio over styles, parts and seeds, its interval over the
     seed-cells (each a row of the bootstrap: one seed gives an interval too)."""
-    return _interval([[ratio] for row in rows for ratio in row], None, rng, False)
+    return _interval([[ratio] for row in rows for ratio in row], rng, percent=False)
 
 
-def _pace(rows):
-    cells = [cell for row in rows for cell in row]
-    passed = sum(c["pace_ok"] for c in cells)
-    total = sum(len(c["amplitude_ratio"]) for c in cells)
-    return f"{passed}/{total}"
+def _pace(rows, rng):
+    total = sum(map(len, _cells(rows, "amplitude_ratio")))
+    return f"{sum(_cells(rows, 'pace_ok'))}/{total}"
 
 
 def _blends(rows, rng):
@@ -420,7 +391,7 @@ def _blends(rows, rng):
     def pairs(passes):
         return f"{np.mean([sum(passes(c) for c in row) for row in rows]):.1f}/{n}"
 
-    one_of_two = _interval(rows, "one_of_two", rng)
+    one_of_two = _interval(rows, rng, "one_of_two")
     return (
         f"{pairs(lambda c: c['speed_between'])}; "
         f"{pairs(lambda c: c['one_of_two'] >= 0.8)} ({one_of_two}); "
@@ -428,76 +399,64 @@ def _blends(rows, rng):
     )
 
 
-def _likelihood(rows):
-    means = [row[0]["mean"] for row in rows]
-    error = max(row[0]["standard_error"] for row in rows)
-    gap = max(row[0]["reverse_gap"] for row in rows)
+def _likelihood(rows, rng):
+    means = _cells(rows, "mean")
+    error, gap = max(_cells(rows, "standard_error")), max(_cells(rows, "reverse_gap"))
     span = f" ({min(means):.2f} to {max(means):.2f})" if len(means) > 1 else ""
     return f"{np.mean(means):.2f}{span}; SE {error:.1e}, gap {gap:.2f}"
 
 
-def _recognition(rows):
-    correct = [row[0]["correct"] for row in rows]
+def _recognition(rows, rng):
+    correct = _cells(rows, "correct")
     return f"{min(correct)}-{max(correct)}/{rows[0][0]['of']}"
 
 
-def _mean(rows, key):
-    return f"{np.mean([row[0][key] for row in rows]):.2f}"
+def _mean(rows, rng, key):
+    return f"{np.mean(_cells(rows, key)):.2f}"
 
 
-# (column, part, formatter of the per-seed rows of cells; ``rng`` for the
+# (column, part, formatter of the per-seed rows of cells and ``rng``, for the
 # bootstrap), for the table's columns in the order of the issue.
 COLUMNS = [
-    ("kept & alive [95%]", "style", lambda r, g: _interval(r, "kept_alive", g)),
-    (
-        "kept",
-        "style",
-        lambda r, g: f"{100 * np.mean([c['kept'] for x in r for c in x]):.0f}%",
-    ),
-    ("in pace", "style", lambda r, g: _pace(r)),
-    ("blown up", "style", lambda r, g: str(sum(c["blown_up"] for x in r for c in x))),
+    ("kept & alive [95%]", "style", partial(_interval, key="kept_alive")),
+    ("kept", "style", lambda r, g: f"{100 * np.mean(_cells(r, 'kept')):.0f}%"),
+    ("in pace", "style", _pace),
+    ("blown up", "style", lambda r, g: str(sum(_cells(r, "blown_up")))),
     (
         "transitions: new & alive [95%]",
         "transitions",
-        lambda r, g: _interval(r, "new_alive", g),
+        partial(_interval, key="new_alive"),
     ),
-    (
-        "blends: speed between; 1 of 2 >= 80% (windows [95%]); freq",
-        "blends",
-        _blends,
-    ),
-    ("held-out LL/frame", "likelihood", lambda r, g: _likelihood(r)),
-    ("recognised", "recognition", lambda r, g: _recognition(r)),
-    ("fill-in log ratio [95%]", "fillin", lambda r, g: _fillin(r, g)),
+    ("blends: speed between; 1 of 2 >= 80% (windows [95%]); freq", "blends", _blends),
+    ("held-out LL/frame", "likelihood", _likelihood),
+    ("recognised", "recognition", _recognition),
+    ("fill-in log ratio [95%]", "fillin", _fillin),
     (
         "100 together / products",
         "speed",
-        lambda r, g: _mean(r, "generation_of_products_bound"),
+        partial(_mean, key="generation_of_products_bound"),
     ),
-    ("s/epoch", "speed", lambda r, g: _mean(r, "seconds_per_epoch")),
+    ("s/epoch", "speed", partial(_mean, key="seconds_per_epoch")),
 ]
 
 
 def table(results, seed=0):
-    """The measures over the seeds (``seed``: of the bootstrap), then the
-    share kept and alive per style."""
+    """The measures over the seeds (``seed``: the bootstrap's), then per style."""
     row = {"seeds": ",".join(str(s) for s in results)}
     styles = [r["style"] for r in results.values() if r.get("style")]
-    means = {
-        s: np.mean([r[s]["kept_alive"] for r in styles])
-        for s in (styles[0] if styles else ())
-    }
+    first = styles[0] if styles else ()
+    means = {s: np.mean([r[s]["kept_alive"] for r in styles]) for s in first}
     lowest = min(means, key=means.get) if means else None
     row["lowest style"] = f"{lowest} {100 * means[lowest]:.0f}%" if means else "-"
     for column, part, formatter in COLUMNS:
         cells = _per_seed(results, part)
-        # each column its own stream: its interval does not depend on the
-        # columns before it
+        # each column its own stream, whatever the columns before it drew
         row[column] = formatter(cells, np.random.default_rng(seed)) if cells else "-"
-    print_table([row], list(row))
+    common.print_table([row], list(row))
     if means:
         print()
-        print_table([{s: f"{100 * m:.0f}%" for s, m in means.items()}], list(means))
+        percents = {s: f"{100 * m:.0f}%" for s, m in means.items()}
+        common.print_table([percents], list(means))
 
 
 # ------------------------------------------------------------------- main
@@ -507,7 +466,7 @@ def run_seed(split, args, seed):
     model = FactoredCRBM(random_state=seed)
     if args.n_iter is not None:
         model.set_params(n_iter=args.n_iter)
-    fit_seconds = seconds(partial(model.fit, Z, styles, sequence_ids=ids))
+    fit_seconds = common.seconds(partial(model.fit, Z, styles, sequence_ids=ids))
     print(f"  seed {seed}: trained in {fit_seconds:.0f} s", flush=True)
     measures = {  # in this order: they draw from one random stream
         "style": lambda: style_kept(model, split, args, rng),
@@ -526,18 +485,14 @@ def run_seed(split, args, seed):
 
 
 def cached_seed(split, args, seed):
-    """``run_seed``'s result, read from the cache when it is there.
-
-    The key is the seed, the options that change a result and the code of
-    the package and of this script, so that runs of disjoint seeds in
-    several processes, and a rerun after a crash, share the work.
-    """
+    """``run_seed``'s result, cached by seed, options and the code of the
+    package and this script (processes of disjoint seeds share the work)."""
     key = hashlib.sha1()
-    for path in sorted([*PACKAGE.rglob("*.py"), Path(__file__)]):
+    for path in sorted([*common.PACKAGE.rglob("*.py"), Path(__file__)]):
         key.update(path.read_bytes())
     options = (seed, args.n_iter, args.parts, args.n_frames, args.n_sequences)
     key.update(repr(options).encode())
-    path = CACHE / "styles" / f"seed{seed}_{key.hexdigest()[:16]}.json"
+    path = common.CACHE / "styles" / f"seed{seed}_{key.hexdigest()[:16]}.json"
     if path.exists():
         return json.loads(path.read_text())
     result = run_seed(split, args, seed)
@@ -547,8 +502,7 @@ def cached_seed(split, args, seed):
 
 
 def tabulate(paths):
-    """Print the tables of the results in earlier runs' JSON files, merged
-    (seeds, and the parts of a seed run apart)."""
+    """Print the tables of earlier runs' JSON (seeds, parts), merged."""
     results = {}
     for path in paths:
         for seed, parts in json.loads(Path(path).read_text())["results"].items():
@@ -559,18 +513,14 @@ def tabulate(paths):
 
 
 def main(argv=None):
-    p = parser(__doc__)
+    p = common.parser(__doc__)
     p.add_argument("--n-iter", type=int, help="epochs (default: the package's)")
     p.add_argument("--parts", nargs="+", default=list(PARTS), choices=PARTS)
     p.add_argument("--n-frames", type=int, default=1000)
     p.add_argument("--n-sequences", type=int, default=6)
-    p.add_argument(
-        "--tabulate",
-        nargs="+",
-        metavar="JSON",
-        help="print the tables of earlier runs' JSON (merged) instead of running",
-    )
-    p.set_defaults(output=str(RESULTS / "styles.json"))
+    merge_help = "print the tables of earlier runs' JSON (merged) instead of running"
+    p.add_argument("--tabulate", nargs="+", metavar="JSON", help=merge_help)
+    p.set_defaults(output=str(common.RESULTS / "styles.json"))
     args = p.parse_args(argv)
     if args.tabulate:
         return tabulate(args.tabulate)
