@@ -49,7 +49,7 @@ from ._labels import (
     label_text,
     seed_windows_for,
 )
-from ._options import COMMANDS, MAX_DEFAULT_RATE
+from ._options import COMMANDS, MAX_DEFAULT_RATE, progress_verbosity
 from ._seed_file import seed_from_file
 from ._style_demo import run_styles as _run_styles
 
@@ -117,7 +117,8 @@ def _model_from_args(args, labelled=False):
     """The ConditionalRBM that ``demo`` and ``fit`` train, from the model
     options; a LabelledCRBM of the same options for ``fit --labels`` with
     several keys."""
-    return (LabelledCRBM if labelled else ConditionalRBM)(
+    model_class = LabelledCRBM if labelled else ConditionalRBM
+    return model_class(
         args.n_components,
         order=args.order,
         n_iter=args.n_iter,
@@ -127,7 +128,7 @@ def _model_from_args(args, labelled=False):
         n_mean_field=args.n_mean_field,
         hidden_drift=args.hidden_drift,
         random_state=args.seed,
-        verbose=max(1, (1000 if args.n_iter == "auto" else args.n_iter) // 10),
+        verbose=progress_verbosity(model_class, args.n_iter),
     )
 
 
@@ -608,7 +609,7 @@ def run_styles(args):
         n_mean_field=args.n_mean_field,
         hidden_drift=args.hidden_drift,
         random_state=args.seed,
-        verbose=max(1, args.n_iter // 10),
+        verbose=progress_verbosity(FactoredCRBM, args.n_iter),
     )
     _check_order(args.order, walks)
     return _run_styles(args, walks, model)

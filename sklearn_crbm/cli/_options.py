@@ -23,6 +23,13 @@ def _epochs(text):
     return text if text == "auto" else _count(1)(text)
 
 
+def progress_verbosity(model_class, n_iter):
+    """``verbose`` for a fit of ``n_iter`` epochs: a line every tenth of them
+    (``"auto"``: of the epochs the class's budget starts from)."""
+    epochs = model_class._update_budget.epochs if n_iter == "auto" else n_iter
+    return max(1, epochs // 10)
+
+
 _FACTORED = FactoredCRBM()
 
 
@@ -179,7 +186,7 @@ _MODEL_OPTIONS = [
         type=_epochs,
         default=_DEFAULTS.n_iter,
         help="training epochs (the paper: 4000); auto: enough for 25,000 "
-        "minibatch updates, at least 1000",
+        "minibatch updates, at least 1000, at most 100,000 updates",
     ),
     *_sampler_options(_DEFAULTS, ", saved with the model"),
     _SEED,
@@ -211,9 +218,10 @@ _FACTORED_OPTIONS = [
     ),
     _option(
         "--n-iter",
-        type=_count(1),
+        type=_epochs,
         default=_FACTORED.n_iter,
-        help="training epochs (the released code: 200)",
+        help="training epochs (the released code: 200); auto: 200, at most "
+        "32,000 minibatch updates",
     ),
     _option(
         "--n-gibbs",
