@@ -379,3 +379,17 @@ def test_it_stacks_any_layer_model():
     assert stack.history_length == 4
     assert np.isfinite(stack.score(X, sequence_ids=ids, context=context))
     assert stack.sample(5, context=context[:1], random_state=0).shape == (5, 6)
+
+
+def test_the_log_likelihood_of_chosen_frames_is_theirs_in_the_whole():
+    X, ids = make_oscillations(n_sequences=2, n_frames=30, random_state=0)
+    model = StackedCRBM([6, 4], order=2, n_iter=2, random_state=0).fit(
+        X, sequence_ids=ids
+    )
+    sequences = base_module.check_sequence_ids(ids, len(X))
+    whole = model._log_likelihood(X, sequences, rng=np.random.default_rng(0))
+    frames = np.array([40, 5, 12])
+    chosen = model._log_likelihood(
+        X, sequences, rng=np.random.default_rng(0), frames=frames
+    )
+    assert_allclose(chosen.log_likelihood, whole.log_likelihood[frames])

@@ -448,7 +448,7 @@ n_classes), default=None
         frames=None,
     ):
         """:class:`~sklearn_crbm._engines._likelihood.LogLikelihood` of every frame
-        (of ``frames`` only, in their order, for a model of one layer)."""
+        (of ``frames`` only, in their order, when given)."""
         layers = self._fitted_layers()
         n_steps, n_chains = self._ais_settings()
         rng = rng_from(self.random_state) if rng is None else rng
@@ -465,8 +465,6 @@ n_classes), default=None
                 reverse=reverse,
                 rng=rng,
             )
-        if frames is not None:
-            raise NotImplementedError("frames= with a stack of layers")
         ops = array_ops(X)
         bounds = [
             stack_log_likelihood_bound(
@@ -481,6 +479,8 @@ n_classes), default=None
             for rows, stack in self._stack_chunks(X, sequences, context=context)
         ]
         bound = ops.concatenate(bounds)
+        if frames is not None:  # a stack's bound needs every frame's past anyway
+            bound = ops.take(bound, ops.asarray(frames), axis=0)
         return LogLikelihood(bound, None, ops.zeros_like(bound), "bound")
 
     @limit_blas_threads(frame_rows)
